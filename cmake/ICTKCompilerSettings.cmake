@@ -1,0 +1,21 @@
+# Warnings, sanitizers and ccache for every ICTK target.
+find_program(ICTK_CCACHE ccache)
+if(ICTK_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
+  set(CMAKE_C_COMPILER_LAUNCHER ${ICTK_CCACHE})
+  set(CMAKE_CXX_COMPILER_LAUNCHER ${ICTK_CCACHE})
+endif()
+
+add_library(ictk_build_flags INTERFACE)
+add_library(ICTK::BuildFlags ALIAS ictk_build_flags)
+if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+  target_compile_options(ictk_build_flags INTERFACE -Wall -Wextra)
+  if(ICTK_NATIVE)
+    target_compile_options(ictk_build_flags INTERFACE -march=native)
+  endif()
+endif()
+
+if(ICTK_ENABLE_SANITIZERS)
+  set(_ictk_san -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_compile_options(${_ictk_san})
+  add_link_options(-fsanitize=address,undefined)
+endif()
