@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "FRep/Expr.h"
 
+#include "FRep/Kernels.h"
+
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -325,68 +327,6 @@ Expr Expr::substitute(const std::array<Expr, AxisCount>& map) const
   return rewritten.at(id());
 }
 
-namespace
-{
-double applyUnary(Opcode op, double a)
-{
-  switch (op)
-  {
-    case Opcode::Neg:
-      return -a;
-    case Opcode::Abs:
-      return std::fabs(a);
-    case Opcode::Sqrt:
-      return std::sqrt(a);
-    case Opcode::Square:
-      return a * a;
-    case Opcode::Exp:
-      return std::exp(a);
-    case Opcode::Log:
-      return std::log(a);
-    case Opcode::Sin:
-      return std::sin(a);
-    case Opcode::Cos:
-      return std::cos(a);
-    case Opcode::Tan:
-      return std::tan(a);
-    case Opcode::Asin:
-      return std::asin(a);
-    case Opcode::Acos:
-      return std::acos(a);
-    case Opcode::Atan:
-      return std::atan(a);
-    case Opcode::Sign:
-      return a > 0 ? 1.0 : (a < 0 ? -1.0 : 0.0);
-    default:
-      throw std::logic_error("applyUnary: not a unary opcode");
-  }
-}
-
-double applyBinary(Opcode op, double a, double b)
-{
-  switch (op)
-  {
-    case Opcode::Add:
-      return a + b;
-    case Opcode::Sub:
-      return a - b;
-    case Opcode::Mul:
-      return a * b;
-    case Opcode::Div:
-      return a / b;
-    case Opcode::Min:
-      return std::fmin(a, b);
-    case Opcode::Max:
-      return std::fmax(a, b);
-    case Opcode::Pow:
-      return std::pow(a, b);
-    case Opcode::Atan2:
-      return std::atan2(a, b);
-    default:
-      throw std::logic_error("applyBinary: not a binary opcode");
-  }
-}
-} // namespace
 
 Expr Expr::make(Opcode op, const Expr& a)
 {
@@ -396,7 +336,7 @@ Expr Expr::make(Opcode op, const Expr& a)
   }
   if (a.isConstant())
   {
-    return constant(applyUnary(op, a.constantValue()));
+    return constant(detail::applyScalar<double>(op, a.constantValue(), 0.0, 0.0));
   }
   if (op == Opcode::Neg && a.opcode() == Opcode::Neg)
   {
@@ -413,7 +353,7 @@ Expr Expr::make(Opcode op, const Expr& a, const Expr& b)
   }
   if (a.isConstant() && b.isConstant())
   {
-    return constant(applyBinary(op, a.constantValue(), b.constantValue()));
+    return constant(detail::applyScalar<double>(op, a.constantValue(), b.constantValue(), 0.0));
   }
   // Identities that are exact in IEEE arithmetic for every finite and infinite operand.
   switch (op)
@@ -621,10 +561,11 @@ double evaluateReference(
           }
           break;
         case 1:
-          v = applyUnary(n.opcode(), values.at(n.child(0).id()));
+          v = detail::applyScalar<double>(n.opcode(), values.at(n.child(0).id()), 0.0, 0.0);
           break;
         case 2:
-          v = applyBinary(n.opcode(), values.at(n.child(0).id()), values.at(n.child(1).id()));
+          v = detail::applyScalar<double>(
+            n.opcode(), values.at(n.child(0).id()), values.at(n.child(1).id()), 0.0);
           break;
         default:
           v = values.at(n.child(0).id()) >= 0 ? values.at(n.child(1).id())

@@ -1,0 +1,685 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "FRep/Evaluators.h"
+
+#include "FRep/Kernels.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace ictk::frep
+{
+
+using detail::applyScalar;
+
+namespace
+{
+void loadParameters(
+  const Tape& tape, const std::vector<double>& parameters, std::vector<double>& destination)
+{
+  if (parameters.size() < tape.parameterCount())
+  {
+    throw std::invalid_argument("the model has " + std::to_string(tape.parameterCount()) +
+      " parameter(s) but " + std::to_string(parameters.size()) + " value(s) were given");
+  }
+  destination.assign(parameters.begin(), parameters.begin() + tape.parameterCount());
+}
+
+template <typename T>
+void runScalar(const std::vector<Instruction>& code, T* s)
+{
+  for (const Instruction& ins : code)
+  {
+    s[ins.out] = applyScalar<T>(ins.op, s[ins.a], s[ins.b], s[ins.c]);
+  }
+}
+} // namespace
+
+// ------------------------------------------------------------------------------------------------
+PointEvaluator::PointEvaluator(TapePtr tape, const std::vector<double>& parameters)
+  : tape_(std::move(tape))
+  , slots_(tape_->slotCount(), 0.0)
+{
+  std::copy(tape_->constants().begin(), tape_->constants().end(),
+    slots_.begin() + tape_->constantBase());
+  setParameters(parameters);
+}
+
+void PointEvaluator::setParameters(const std::vector<double>& parameters)
+{
+  std::vector<double> p;
+  loadParameters(*tape_, parameters, p);
+  std::copy(p.begin(), p.end(), slots_.begin() + tape_->parameterBase());
+}
+
+double PointEvaluator::eval(double x, double y, double z, double t)
+{
+  double* s = slots_.data();
+  s[0] = x;
+  s[1] = y;
+  s[2] = z;
+  s[3] = t;
+  runScalar(tape_->instructions(), s);
+  return s[tape_->outputs()[0]];
+}
+
+void PointEvaluator::evalAll(const std::array<double, 4>& p, double* out)
+{
+  eval(p[0], p[1], p[2], p[3]);
+  for (std::size_t i = 0; i < tape_->outputs().size(); ++i)
+  {
+    out[i] = slots_[tape_->outputs()[i]];
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+namespace
+{
+// One instruction over n points. Every case is a plain loop over non-aliasing arrays (the register
+// allocator never gives an instruction its own input slot), so the compiler vectorises them.
+template <typename T>
+void runChunk(const std::vector<Instruction>& code, T* storage, std::size_t stride, std::size_t n)
+{
+  for (const Instruction& ins : code)
+  {
+    T* __restrict o = storage + ins.out * stride;
+    const T* __restrict a = storage + ins.a * stride;
+    const T* __restrict b = storage + ins.b * stride;
+    const T* __restrict c = storage + ins.c * stride;
+#define ICTK_LOOP(expr)                                                                            \
+  for (std::size_t i = 0; i < n; ++i)                                                              \
+  {                                                                                                \
+    o[i] = (expr);                                                                                 \
+  }                                                                                                \
+  break
+    switch (ins.op)
+    {
+      case Opcode::Neg:
+        ICTK_LOOP(-a[i]);
+      case Opcode::Abs:
+        ICTK_LOOP(std::abs(a[i]));
+      case Opcode::Sqrt:
+        ICTK_LOOP(std::sqrt(a[i]));
+      case Opcode::Square:
+        ICTK_LOOP(a[i] * a[i]);
+      case Opcode::Add:
+        ICTK_LOOP(a[i] + b[i]);
+      case Opcode::Sub:
+        ICTK_LOOP(a[i] - b[i]);
+      case Opcode::Mul:
+        ICTK_LOOP(a[i] * b[i]);
+      case Opcode::Div:
+        ICTK_LOOP(a[i] / b[i]);
+      case Opcode::Min:
+        ICTK_LOOP(detail::minOp(a[i], b[i]));
+      case Opcode::Max:
+        ICTK_LOOP(detail::maxOp(a[i], b[i]));
+      case Opcode::Select:
+        ICTK_LOOP(a[i] >= T(0) ? b[i] : c[i]);
+      default:
+        ICTK_LOOP(applyScalar<T>(ins.op, a[i], b[i], c[i]));
+    }
+#undef ICTK_LOOP
+  }
+}
+} // namespace
+
+template <typename T>
+BatchEvaluator<T>::BatchEvaluator(TapePtr tape, const std::vector<double>& parameters)
+  : tape_(std::move(tape))
+{
+  loadParameters(*tape_, parameters, parameters_);
+  prepare();
+}
+
+template <typename T>
+void BatchEvaluator<T>::setParameters(const std::vector<double>& parameters)
+{
+  loadParameters(*tape_, parameters, parameters_);
+  prepare();
+}
+
+template <typename T>
+void BatchEvaluator<T>::setTape(TapePtr tape)
+{
+  if (tape->parameterCount() > parameters_.size())
+  {
+    throw std::invalid_argument("BatchEvaluator::setTape: the new tape needs more parameters");
+  }
+  tape_ = std::move(tape);
+  prepare();
+}
+
+template <typename T>
+void BatchEvaluator<T>::prepare()
+{
+  const Tape& tape = *tape_;
+  // Full tape: leaves in fixed slots, constants and parameters broadcast once.
+  storage_.assign(static_cast<std::size_t>(tape.slotCount()) * ChunkSize, T(0));
+  auto fill = [&](std::uint32_t slot, double v)
+  { std::fill_n(storage_.begin() + slot * ChunkSize, ChunkSize, static_cast<T>(v)); };
+  for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
+  {
+    fill(tape.parameterBase() + i, parameters_[i]);
+  }
+  for (std::size_t i = 0; i < tape.constants().size(); ++i)
+  {
+    fill(tape.constantBase() + static_cast<std::uint32_t>(i), tape.constants()[i]);
+  }
+  // Row program along x.
+  row_ = tape.rowProgram(1u << static_cast<int>(Axis::X));
+  rowStorage_.assign(static_cast<std::size_t>(row_.chunkSlotCount) * ChunkSize, T(0));
+  scalars_.assign(row_.scalarSlotCount, T(0));
+  for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
+  {
+    scalars_[tape.parameterBase() + i] = static_cast<T>(parameters_[i]);
+  }
+  for (std::size_t i = 0; i < tape.constants().size(); ++i)
+  {
+    scalars_[tape.constantBase() + i] = static_cast<T>(tape.constants()[i]);
+  }
+}
+
+template <typename T>
+void BatchEvaluator<T>::eval(const T* x, const T* y, const T* z, const T* t, T* out, std::size_t n)
+{
+  const T* inputs[4] = { x, y, z, t };
+  for (int a = 0; a < 4; ++a)
+  {
+    if (!inputs[a] && (tape_->axesUsed() & (1u << a)))
+    {
+      throw std::invalid_argument(std::string("BatchEvaluator::eval: the model uses coordinate ") +
+        axisName(static_cast<Axis>(a)) + " but no values were given for it");
+    }
+  }
+  const std::uint32_t outSlot = tape_->outputs()[0];
+  for (std::size_t start = 0; start < n; start += ChunkSize)
+  {
+    const std::size_t m = std::min(ChunkSize, n - start);
+    for (int a = 0; a < 4; ++a)
+    {
+      if (inputs[a])
+      {
+        std::copy_n(inputs[a] + start, m, storage_.begin() + a * ChunkSize);
+      }
+    }
+    runChunk<T>(tape_->instructions(), storage_.data(), ChunkSize, m);
+    std::copy_n(storage_.begin() + outSlot * ChunkSize, m, out + start);
+  }
+}
+
+template <typename T>
+void BatchEvaluator<T>::evalRowX(
+  double x0, double dx, std::int64_t first, double y, double z, double t, T* out, std::size_t n)
+{
+  T* s = scalars_.data();
+  s[0] = static_cast<T>(x0 + static_cast<double>(first) * dx);
+  s[1] = static_cast<T>(y);
+  s[2] = static_cast<T>(z);
+  s[3] = static_cast<T>(t);
+  runScalar(row_.uniform, s);
+  const RowProgram::Output& output = row_.outputs[0];
+  if (!output.varying)
+  {
+    std::fill_n(out, n, s[output.slot]);
+    return;
+  }
+  T* storage = rowStorage_.data();
+  for (const auto& [scalar, chunk] : row_.broadcasts)
+  {
+    std::fill_n(storage + chunk * ChunkSize, ChunkSize, s[scalar]);
+  }
+  T* xs = storage + row_.axisSlots[0] * ChunkSize;
+  for (std::size_t start = 0; start < n; start += ChunkSize)
+  {
+    const std::size_t m = std::min(ChunkSize, n - start);
+    for (std::size_t i = 0; i < m; ++i)
+    {
+      // Coordinates in double, as every other evaluator receives them.
+      xs[i] = static_cast<T>(x0 + static_cast<double>(first + static_cast<std::int64_t>(start + i)) * dx);
+    }
+    runChunk<T>(row_.varying, storage, ChunkSize, m);
+    std::copy_n(storage + output.slot * ChunkSize, m, out + start);
+  }
+}
+
+template class BatchEvaluator<float>;
+template class BatchEvaluator<double>;
+
+// ------------------------------------------------------------------------------------------------
+namespace
+{
+constexpr double inf = std::numeric_limits<double>::infinity();
+constexpr double pi = 3.14159265358979323846;
+
+// Outward rounding by one ulp each side: the libm functions used are faithful to within an ulp,
+// so the widened interval encloses every value the point evaluators can produce.
+Interval widen(Interval r)
+{
+  return { std::nextafter(r.lo, -inf), std::nextafter(r.hi, inf), r.maybeNaN };
+}
+
+Interval nowhere()
+{
+  return { inf, -inf, true };
+}
+
+Interval hull(const Interval& a, const Interval& b)
+{
+  return { std::min(a.lo, b.lo), std::max(a.hi, b.hi), a.maybeNaN || b.maybeNaN };
+}
+
+bool hasInfinity(const Interval& a)
+{
+  return std::isinf(a.lo) || std::isinf(a.hi);
+}
+
+Interval monotoneIncreasing(double (*f)(double), const Interval& a)
+{
+  return widen({ f(a.lo), f(a.hi), a.maybeNaN });
+}
+
+Interval mul(const Interval& a, const Interval& b)
+{
+  const double p[4] = { a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi };
+  double lo = inf, hi = -inf;
+  for (double v : p)
+  {
+    // 0 * inf is NaN: a zero bound times an infinite one contributes 0 to the finite values.
+    v = std::isnan(v) ? 0.0 : v;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  const bool zeroTimesInf = (a.contains(0) && hasInfinity(b)) || (b.contains(0) && hasInfinity(a));
+  return widen({ lo, hi, a.maybeNaN || b.maybeNaN || zeroTimesInf });
+}
+
+Interval squareRange(const Interval& a)
+{
+  if (a.lo >= 0)
+    return widen({ a.lo * a.lo, a.hi * a.hi, a.maybeNaN });
+  if (a.hi <= 0)
+    return widen({ a.hi * a.hi, a.lo * a.lo, a.maybeNaN });
+  return widen({ 0.0, std::max(a.lo * a.lo, a.hi * a.hi), a.maybeNaN });
+}
+
+// Range of sin or cos over [lo, hi]: the extremes are at the ends or at the maxima (sin: pi/2 +
+// 2k pi, cos: 2k pi) and minima (half a period further) inside the interval.
+Interval trigRange(bool isSin, const Interval& a)
+{
+  if (hasInfinity(a))
+    return { -1.0, 1.0, true }; // sin(inf) is NaN
+  if (!(a.hi - a.lo < 2 * pi))
+    return { -1.0, 1.0, a.maybeNaN };
+  double (*f)(double) = isSin ? static_cast<double (*)(double)>(std::sin) : static_cast<double (*)(double)>(std::cos);
+  double lo = std::min(f(a.lo), f(a.hi));
+  double hi = std::max(f(a.lo), f(a.hi));
+  const double maxAt = isSin ? pi / 2 : 0.0;
+  if (maxAt + 2 * pi * std::ceil((a.lo - maxAt) / (2 * pi)) <= a.hi)
+    hi = 1.0;
+  const double minAt = maxAt + pi;
+  if (minAt + 2 * pi * std::ceil((a.lo - minAt) / (2 * pi)) <= a.hi)
+    lo = -1.0;
+  Interval r = widen({ lo, hi, a.maybeNaN });
+  return { std::max(r.lo, -1.0), std::min(r.hi, 1.0), r.maybeNaN };
+}
+
+// The interval counterpart of each opcode. Choices mirror the point semantics exactly, including
+// NaN: minOp(a, b) and maxOp(a, b) return a whenever either operand is NaN, and select takes its
+// second branch when the condition is NaN; so deciding for the first operand is always safe, and
+// deciding for the second needs operands that cannot be NaN.
+Interval intervalOp(Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice)
+{
+  choice = Choice::Both;
+  switch (op)
+  {
+    case Opcode::Min:
+    case Opcode::Max:
+    {
+      if (a.empty())
+      {
+        choice = Choice::First;
+        return a;
+      }
+      if (b.empty())
+      {
+        choice = Choice::First;
+        return a;
+      }
+      const bool isMin = op == Opcode::Min;
+      // Ties return the first operand, so a.hi <= b.lo decides a min for a.
+      if (isMin ? a.hi <= b.lo : a.lo >= b.hi)
+      {
+        choice = Choice::First;
+        return a;
+      }
+      if (!a.maybeNaN && !b.maybeNaN && (isMin ? b.hi < a.lo : b.lo > a.hi))
+      {
+        choice = Choice::Second;
+        return b;
+      }
+      Interval r = isMin ? Interval{ std::min(a.lo, b.lo), std::min(a.hi, b.hi), a.maybeNaN }
+                         : Interval{ std::max(a.lo, b.lo), std::max(a.hi, b.hi), a.maybeNaN };
+      if (b.maybeNaN)
+      {
+        r = hull(r, a); // where b is NaN the result is a
+      }
+      return r;
+    }
+    case Opcode::Select:
+      if (a.empty() || a.hi < 0)
+      {
+        choice = Choice::Second;
+        return c;
+      }
+      if (a.lo >= 0 && !a.maybeNaN)
+      {
+        choice = Choice::First;
+        return b;
+      }
+      if (b.empty())
+        return { c.lo, c.hi, true };
+      if (c.empty())
+        return { b.lo, b.hi, true };
+      return hull(b, c);
+    case Opcode::Sign:
+      if (a.empty())
+        return { 0.0, 0.0, false };
+      return hull({ detail::signOp(a.lo), detail::signOp(a.hi), false },
+        a.maybeNaN ? Interval{ 0.0, 0.0, false } : Interval{ detail::signOp(a.lo), detail::signOp(a.lo), false });
+    case Opcode::Pow:
+      // pow(1, NaN) and pow(NaN, 0) are 1: NaN operands do not make a NaN result.
+      if (a.empty() || b.empty() || a.maybeNaN || b.maybeNaN)
+        return { -inf, inf, true };
+      break;
+    default:
+      break;
+  }
+  const int arity = opcodeArity(op);
+  if (a.empty() || (arity > 1 && b.empty()))
+  {
+    return nowhere();
+  }
+  const bool nanIn = a.maybeNaN || (arity > 1 && b.maybeNaN);
+  switch (op)
+  {
+    case Opcode::Neg:
+      return { -a.hi, -a.lo, a.maybeNaN };
+    case Opcode::Abs:
+      if (a.lo >= 0)
+        return a;
+      if (a.hi <= 0)
+        return { -a.hi, -a.lo, a.maybeNaN };
+      return { 0.0, std::max(-a.lo, a.hi), a.maybeNaN };
+    case Opcode::Sqrt:
+      if (a.hi < 0)
+        return nowhere();
+      return widen({ std::sqrt(std::max(a.lo, 0.0)), std::sqrt(a.hi), a.maybeNaN || a.lo < 0 });
+    case Opcode::Square:
+      return squareRange(a);
+    case Opcode::Exp:
+      return monotoneIncreasing(std::exp, a);
+    case Opcode::Log:
+      if (a.hi < 0)
+        return nowhere();
+      return widen({ a.lo <= 0 ? -inf : std::log(a.lo), std::log(a.hi), a.maybeNaN || a.lo < 0 });
+    case Opcode::Sin:
+      return trigRange(true, a);
+    case Opcode::Cos:
+      return trigRange(false, a);
+    case Opcode::Tan:
+    {
+      // Monotone between the poles at pi/2 + k pi.
+      const double k = std::ceil((a.lo - pi / 2) / pi);
+      if (hasInfinity(a))
+        return { -inf, inf, true };
+      if (!(a.hi - a.lo < pi) || pi / 2 + k * pi <= a.hi)
+        return { -inf, inf, a.maybeNaN };
+      return monotoneIncreasing(std::tan, a);
+    }
+    case Opcode::Asin:
+    case Opcode::Acos:
+    {
+      if (a.hi < -1 || a.lo > 1)
+        return nowhere();
+      const double lo = std::max(a.lo, -1.0), hi = std::min(a.hi, 1.0);
+      const bool outside = a.maybeNaN || a.lo < -1 || a.hi > 1;
+      if (op == Opcode::Asin)
+        return widen({ std::asin(lo), std::asin(hi), outside });
+      return widen({ std::acos(hi), std::acos(lo), outside });
+    }
+    case Opcode::Atan:
+      return monotoneIncreasing(std::atan, a);
+    case Opcode::Add:
+    {
+      const bool infMinusInf = (a.hi == inf && b.lo == -inf) || (a.lo == -inf && b.hi == inf);
+      Interval r = widen({ a.lo + b.lo, a.hi + b.hi, nanIn || infMinusInf });
+      if (std::isnan(r.lo) || std::isnan(r.hi))
+        return { -inf, inf, true };
+      return r;
+    }
+    case Opcode::Sub:
+    {
+      const bool infMinusInf = (a.hi == inf && b.hi == inf) || (a.lo == -inf && b.lo == -inf);
+      Interval r = widen({ a.lo - b.hi, a.hi - b.lo, nanIn || infMinusInf });
+      if (std::isnan(r.lo) || std::isnan(r.hi))
+        return { -inf, inf, true };
+      return r;
+    }
+    case Opcode::Mul:
+      return mul(a, b);
+    case Opcode::Div:
+      if (b.lo > 0 || b.hi < 0)
+      {
+        const bool infOverInf = hasInfinity(a) && hasInfinity(b);
+        Interval r = mul(a, widen({ 1.0 / b.hi, 1.0 / b.lo, b.maybeNaN }));
+        r.maybeNaN = r.maybeNaN || infOverInf;
+        if (infOverInf)
+          return { -inf, inf, true };
+        return r;
+      }
+      return { -inf, inf, true }; // 0/0 possible
+    case Opcode::Pow:
+    {
+      if (a.lo > 0 && std::isfinite(a.hi) && std::isfinite(b.lo) && std::isfinite(b.hi))
+      {
+        // a^b = exp(b ln a) is monotone in b ln a, which is bilinear in (b, ln a): extremes at
+        // the corners.
+        const double p[4] = { std::pow(a.lo, b.lo), std::pow(a.lo, b.hi), std::pow(a.hi, b.lo),
+          std::pow(a.hi, b.hi) };
+        return widen({ *std::min_element(p, p + 4), *std::max_element(p, p + 4), nanIn });
+      }
+      return { -inf, inf, true };
+    }
+    case Opcode::Atan2:
+      // For x > 0, atan2(y, x) = atan(y / x) and y / x is monotone in each argument: corners.
+      if (b.lo > 0 && !hasInfinity(a) && !hasInfinity(b))
+      {
+        const double p[4] = { std::atan2(a.lo, b.lo), std::atan2(a.lo, b.hi),
+          std::atan2(a.hi, b.lo), std::atan2(a.hi, b.hi) };
+        return widen({ *std::min_element(p, p + 4), *std::max_element(p, p + 4), nanIn });
+      }
+      return { -pi, pi, nanIn };
+    default:
+      return { -inf, inf, true };
+  }
+}
+} // namespace
+
+IntervalEvaluator::IntervalEvaluator(TapePtr tape, const std::vector<double>& parameters)
+  : tape_(std::move(tape))
+  , slots_(tape_->slotCount())
+  , choices_(tape_->instructions().size(), Choice::Both)
+{
+  for (std::size_t i = 0; i < tape_->constants().size(); ++i)
+  {
+    const double v = tape_->constants()[i];
+    slots_[tape_->constantBase() + i] = { v, v, std::isnan(v) };
+  }
+  setParameters(parameters);
+}
+
+void IntervalEvaluator::setParameters(const std::vector<double>& parameters)
+{
+  std::vector<double> p;
+  loadParameters(*tape_, parameters, p);
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    slots_[tape_->parameterBase() + i] = { p[i], p[i], std::isnan(p[i]) };
+  }
+}
+
+Interval IntervalEvaluator::eval(const Region& region)
+{
+  for (int a = 0; a < 4; ++a)
+  {
+    slots_[a] = region.axes[a];
+  }
+  const auto& code = tape_->instructions();
+  for (std::size_t i = 0; i < code.size(); ++i)
+  {
+    const Instruction& ins = code[i];
+    slots_[ins.out] = intervalOp(ins.op, slots_[ins.a], slots_[ins.b], slots_[ins.c], choices_[i]);
+  }
+  return slots_[tape_->outputs()[0]];
+}
+
+// ------------------------------------------------------------------------------------------------
+namespace
+{
+ValueGradient chain(double value, const ValueGradient& a, double derivative)
+{
+  ValueGradient r;
+  r.value = value;
+  for (int k = 0; k < 4; ++k)
+  {
+    // A zero partial stays zero even where the derivative is infinite (sqrt at 0).
+    r.gradient[k] = a.gradient[k] == 0 ? 0 : derivative * a.gradient[k];
+  }
+  return r;
+}
+
+ValueGradient combine(double value, const ValueGradient& a, double da, const ValueGradient& b, double db)
+{
+  ValueGradient r;
+  r.value = value;
+  for (int k = 0; k < 4; ++k)
+  {
+    r.gradient[k] = (a.gradient[k] == 0 ? 0 : da * a.gradient[k]) +
+      (b.gradient[k] == 0 ? 0 : db * b.gradient[k]);
+  }
+  return r;
+}
+
+ValueGradient gradientOp(Opcode op, const ValueGradient& a, const ValueGradient& b, const ValueGradient& c)
+{
+  const double x = a.value, y = b.value;
+  const double v = applyScalar<double>(op, x, y, c.value);
+  switch (op)
+  {
+    case Opcode::Neg:
+      return chain(v, a, -1);
+    case Opcode::Abs:
+      return chain(v, a, detail::signOp(x));
+    case Opcode::Sqrt:
+      // The derivative is infinite at 0; report 0 there rather than inf * 0 = NaN.
+      return chain(v, a, v > 0 ? 0.5 / v : 0.0);
+    case Opcode::Square:
+      return chain(v, a, 2 * x);
+    case Opcode::Exp:
+      return chain(v, a, v);
+    case Opcode::Log:
+      return chain(v, a, 1 / x);
+    case Opcode::Sin:
+      return chain(v, a, std::cos(x));
+    case Opcode::Cos:
+      return chain(v, a, -std::sin(x));
+    case Opcode::Tan:
+      return chain(v, a, 1 + v * v);
+    case Opcode::Asin:
+      return chain(v, a, 1 / std::sqrt(1 - x * x));
+    case Opcode::Acos:
+      return chain(v, a, -1 / std::sqrt(1 - x * x));
+    case Opcode::Atan:
+      return chain(v, a, 1 / (1 + x * x));
+    case Opcode::Sign:
+      return chain(v, a, 0);
+    case Opcode::Add:
+      return combine(v, a, 1, b, 1);
+    case Opcode::Sub:
+      return combine(v, a, 1, b, -1);
+    case Opcode::Mul:
+      return combine(v, a, y, b, x);
+    case Opcode::Div:
+      return combine(v, a, 1 / y, b, -x / (y * y));
+    case Opcode::Min:
+      return y < x ? chain(v, b, 1) : chain(v, a, 1);
+    case Opcode::Max:
+      return !(x < y) ? chain(v, a, 1) : chain(v, b, 1);
+    case Opcode::Pow:
+      return combine(v, a, y * std::pow(x, y - 1), b, x > 0 ? v * std::log(x) : 0.0);
+    case Opcode::Atan2:
+    {
+      const double r2 = x * x + y * y;
+      return combine(v, a, y / r2, b, -x / r2);
+    }
+    case Opcode::Select:
+      return x >= 0 ? chain(v, b, 1) : chain(v, c, 1);
+    default:
+      return chain(v, a, 0);
+  }
+}
+} // namespace
+
+GradientEvaluator::GradientEvaluator(TapePtr tape, const std::vector<double>& parameters)
+  : tape_(std::move(tape))
+  , slots_(tape_->slotCount())
+{
+  for (std::size_t i = 0; i < tape_->constants().size(); ++i)
+  {
+    slots_[tape_->constantBase() + i].value = tape_->constants()[i];
+  }
+  for (int a = 0; a < 4; ++a)
+  {
+    slots_[a].gradient[a] = 1.0;
+  }
+  setParameters(parameters);
+}
+
+void GradientEvaluator::setParameters(const std::vector<double>& parameters)
+{
+  std::vector<double> p;
+  loadParameters(*tape_, parameters, p);
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    slots_[tape_->parameterBase() + i].value = p[i];
+  }
+}
+
+ValueGradient GradientEvaluator::eval(double x, double y, double z, double t)
+{
+  slots_[0].value = x;
+  slots_[1].value = y;
+  slots_[2].value = z;
+  slots_[3].value = t;
+  for (const Instruction& ins : tape_->instructions())
+  {
+    slots_[ins.out] = gradientOp(ins.op, slots_[ins.a], slots_[ins.b], slots_[ins.c]);
+  }
+  return slots_[tape_->outputs()[0]];
+}
+
+std::array<double, 3> outwardNormal(const ValueGradient& g)
+{
+  const double n = std::sqrt(
+    g.gradient[0] * g.gradient[0] + g.gradient[1] * g.gradient[1] + g.gradient[2] * g.gradient[2]);
+  if (!(n > 0) || !std::isfinite(n))
+  {
+    return { 0, 0, 0 };
+  }
+  return { -g.gradient[0] / n, -g.gradient[1] / n, -g.gradient[2] / n };
+}
+
+} // namespace ictk::frep

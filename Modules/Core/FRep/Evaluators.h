@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// The four evaluators of a tape. Each evaluator owns its scratch memory and is not thread-safe;
+// give each thread its own (a tape is immutable and shared freely).
+
+#include "FRep/Interval.h"
+#include "FRep/Tape.h"
+
+#include <array>
+#include <vector>
+
+namespace ictk::frep
+{
+
+/// Evaluates one point in double precision.
+class PointEvaluator
+{
+public:
+  explicit PointEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  void setParameters(const std::vector<double>& parameters);
+  /// The first output at (x, y, z, t).
+  double eval(double x, double y, double z = 0, double t = 0);
+  /// Every output at p; `out` has tape->outputs().size() entries.
+  void evalAll(const std::array<double, 4>& p, double* out);
+  const TapePtr& tape() const { return tape_; }
+
+private:
+  TapePtr tape_;
+  std::vector<double> slots_;
+};
+
+/// Evaluates arrays of points; each instruction runs as one loop over a chunk of points, so the
+/// compiler vectorises it. T is float or double.
+template <typename T>
+class BatchEvaluator
+{
+public:
+  static constexpr std::size_t ChunkSize = 256;
+
+  explicit BatchEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  void setParameters(const std::vector<double>& parameters);
+  /// out[i] = first output at (x[i], y[i], z[i], t[i]); any of the coordinate pointers may be
+  /// null for an axis the tape does not use.
+  void eval(const T* x, const T* y, const T* z, const T* t, T* out, std::size_t n);
+  /// One grid row: points (x0 + (first + i) dx, y, z, t) for i < n, the coordinates computed in
+  /// double exactly so. Instructions that do not depend on x run once for the row. Gives the same
+  /// values as eval() on those points.
+  void evalRowX(double x0, double dx, std::int64_t first, double y, double z, double t, T* out,
+    std::size_t n);
+  /// Replaces the tape (e.g. by a region's simplified tape) keeping the parameters.
+  void setTape(TapePtr tape);
+  const TapePtr& tape() const { return tape_; }
+
+private:
+  void prepare();
+
+  TapePtr tape_;
+  std::vector<double> parameters_;
+  std::vector<T> storage_;    // eval(): slotCount chunks
+  RowProgram row_;            // evalRowX(): the tape split along x
+  std::vector<T> rowStorage_; // evalRowX(): chunkSlotCount chunks
+  std::vector<T> scalars_;    // evalRowX(): one value per value id
+};
+
+/// Interval arithmetic over a region, with the choices needed to simplify the tape there.
+class IntervalEvaluator
+{
+public:
+  explicit IntervalEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  void setParameters(const std::vector<double>& parameters);
+  /// An interval that encloses the first output over the region.
+  Interval eval(const Region& region);
+  /// The choices made by the last eval (one per instruction).
+  const std::vector<Choice>& choices() const { return choices_; }
+  /// The tape simplified for the region of the last eval.
+  TapePtr simplified() const { return tape_->simplify(choices_); }
+  const TapePtr& tape() const { return tape_; }
+
+private:
+  TapePtr tape_;
+  std::vector<Interval> slots_;
+  std::vector<Choice> choices_;
+};
+
+/// Value and gradient (d/dx, d/dy, d/dz, d/dt) by forward-mode differentiation.
+struct ValueGradient
+{
+  double value = 0;
+  std::array<double, 4> gradient{};
+};
+
+class GradientEvaluator
+{
+public:
+  explicit GradientEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  void setParameters(const std::vector<double>& parameters);
+  ValueGradient eval(double x, double y, double z = 0, double t = 0);
+  const TapePtr& tape() const { return tape_; }
+
+private:
+  TapePtr tape_;
+  std::vector<ValueGradient> slots_;
+};
+
+/// Outward unit normal n = -grad f / |grad f| (thesis L608-L610); zero where the gradient vanishes.
+std::array<double, 3> outwardNormal(const ValueGradient& g);
+
+} // namespace ictk::frep

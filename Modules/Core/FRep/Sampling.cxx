@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "FRep/Sampling.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+namespace ictk::frep
+{
+
+Grid gridOverBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi,
+  const std::array<std::int64_t, 3>& resolution, double time)
+{
+  Grid g;
+  g.time = time;
+  for (int a = 0; a < 3; ++a)
+  {
+    g.origin[a] = lo[a];
+    g.dimensions[a] = resolution[a];
+    g.spacing[a] = resolution[a] > 1 ? (hi[a] - lo[a]) / static_cast<double>(resolution[a] - 1)
+                                     : std::max(hi[a] - lo[a], 1.0);
+  }
+  return g;
+}
+
+namespace
+{
+std::size_t physicalMemory()
+{
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long pageSize = sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || pageSize <= 0)
+  {
+    return std::size_t(1) << 32;
+  }
+  return static_cast<std::size_t>(pages) * static_cast<std::size_t>(pageSize);
+}
+} // namespace
+
+void checkGrid(const Grid& grid, std::size_t bytesPerPoint, std::size_t maxBytes)
+{
+  static const char* names[] = { "x", "y", "z" };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (grid.dimensions[a] < 1)
+    {
+      throw std::invalid_argument(std::string("grid: dimension along ") + names[a] + " is " +
+        std::to_string(grid.dimensions[a]) + "; it must be at least 1");
+    }
+    if (!std::isfinite(grid.origin[a]) || !std::isfinite(grid.spacing[a]) || !(grid.spacing[a] > 0))
+    {
+      std::ostringstream os;
+      os << "grid: origin " << grid.origin[a] << " and spacing " << grid.spacing[a] << " along "
+         << names[a] << " must be finite, with a positive spacing";
+      throw std::invalid_argument(os.str());
+    }
+  }
+  if (!std::isfinite(grid.time))
+  {
+    throw std::invalid_argument("grid: the time must be finite");
+  }
+  if (maxBytes == 0)
+  {
+    maxBytes = physicalMemory() / 10 * 8;
+  }
+  // Overflow-safe product: compare in long double.
+  const long double bytes = static_cast<long double>(grid.dimensions[0]) * grid.dimensions[1] *
+    grid.dimensions[2] * static_cast<long double>(bytesPerPoint);
+  if (bytes > static_cast<long double>(maxBytes))
+  {
+    std::ostringstream os;
+    os.precision(3);
+    os << "grid: " << grid.dimensions[0] << " x " << grid.dimensions[1] << " x "
+       << grid.dimensions[2] << " points need " << static_cast<double>(bytes / 1e9)
+       << " GB, more than the " << static_cast<double>(maxBytes) / 1e9 << " GB allowed";
+    throw std::invalid_argument(os.str());
+  }
+}
+
+namespace
+{
+template <typename T>
+struct Workspace
+{
+  Workspace(const TapePtr& tape, const std::vector<double>& parameters)
+    : batch(tape, parameters)
+    , interval(tape, parameters)
+  {
+  }
+  BatchEvaluator<T> batch;
+  IntervalEvaluator interval;
+};
+
+template <typename T>
+void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& options)
+{
+  checkGrid(grid, sizeof(T));
+  if (tape->parameterCount() > options.parameters.size())
+  {
+    throw std::invalid_argument("sampleGrid: the model has " +
+      std::to_string(tape->parameterCount()) + " parameter(s) but " +
+      std::to_string(options.parameters.size()) + " value(s) were given");
+  }
+  const std::int64_t brick = std::max(1, options.brickSize);
+  const auto& dims = grid.dimensions;
+  std::array<std::int64_t, 3> bricks;
+  for (int a = 0; a < 3; ++a)
+  {
+    bricks[a] = (dims[a] + brick - 1) / brick;
+  }
+  const std::int64_t brickCount = bricks[0] * bricks[1] * bricks[2];
+
+  tbb::enumerable_thread_specific<std::optional<Workspace<T>>> workspaces;
+  std::atomic<std::int64_t> done{ 0 };
+  std::atomic<bool> cancelled{ false };
+  const std::thread::id caller = std::this_thread::get_id();
+  std::int64_t lastReported = -1;
+  const std::int64_t reportEvery = std::max<std::int64_t>(1, brickCount / 100);
+
+  auto sampleBrick = [&](std::int64_t b)
+  {
+    auto& slot = workspaces.local();
+    if (!slot)
+    {
+      slot.emplace(tape, options.parameters);
+    }
+    Workspace<T>& ws = *slot;
+    const std::int64_t bi = b % bricks[0], bj = (b / bricks[0]) % bricks[1], bk = b / (bricks[0] * bricks[1]);
+    const std::int64_t i0 = bi * brick, j0 = bj * brick, k0 = bk * brick;
+    const std::int64_t i1 = std::min(dims[0], i0 + brick), j1 = std::min(dims[1], j0 + brick),
+                       k1 = std::min(dims[2], k0 + brick);
+    if (options.prune)
+    {
+      Region region;
+      region.axes[0] = { grid.origin[0] + i0 * grid.spacing[0], grid.origin[0] + (i1 - 1) * grid.spacing[0] };
+      region.axes[1] = { grid.origin[1] + j0 * grid.spacing[1], grid.origin[1] + (j1 - 1) * grid.spacing[1] };
+      region.axes[2] = { grid.origin[2] + k0 * grid.spacing[2], grid.origin[2] + (k1 - 1) * grid.spacing[2] };
+      region.axes[3] = { grid.time, grid.time };
+      ws.interval.eval(region);
+      ws.batch.setTape(ws.interval.simplified());
+    }
+    for (std::int64_t k = k0; k < k1; ++k)
+    {
+      const double z = grid.origin[2] + k * grid.spacing[2];
+      for (std::int64_t j = j0; j < j1; ++j)
+      {
+        const double y = grid.origin[1] + j * grid.spacing[1];
+        T* row = out + (k * dims[1] + j) * dims[0] + i0;
+        ws.batch.evalRowX(grid.origin[0], grid.spacing[0], i0, y, z, grid.time, row,
+          static_cast<std::size_t>(i1 - i0));
+      }
+    }
+  };
+
+  auto body = [&](const tbb::blocked_range<std::int64_t>& range)
+  {
+    for (std::int64_t b = range.begin(); b != range.end(); ++b)
+    {
+      if (cancelled.load(std::memory_order_relaxed))
+      {
+        return;
+      }
+      sampleBrick(b);
+      const std::int64_t n = done.fetch_add(1) + 1;
+      // Progress is reported only from the calling thread, as VTK and GUIs expect.
+      if (options.progress && std::this_thread::get_id() == caller && n - lastReported >= reportEvery)
+      {
+        lastReported = n;
+        if (!options.progress(static_cast<double>(n) / static_cast<double>(brickCount)))
+        {
+          cancelled = true;
+        }
+      }
+    }
+  };
+  // Row evaluation and brick pruning are independent of which thread runs a brick, so the output
+  // does not depend on the thread count.
+  if (options.threads > 0)
+  {
+    tbb::task_arena arena(options.threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body); });
+  }
+  else
+  {
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body);
+  }
+  if (cancelled)
+  {
+    throw Cancelled();
+  }
+  if (options.progress)
+  {
+    options.progress(1.0);
+  }
+}
+} // namespace
+
+void sampleGrid(const TapePtr& tape, const Grid& grid, float* out, const SampleOptions& options)
+{
+  sample(tape, grid, out, options);
+}
+
+void sampleGrid(const TapePtr& tape, const Grid& grid, double* out, const SampleOptions& options)
+{
+  sample(tape, grid, out, options);
+}
+
+} // namespace ictk::frep

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// Dense sampling of a tape on a regular grid, multithreaded with TBB. The result is identical for
+// any thread count: every point is computed by the same arithmetic on the same (or a provably
+// equivalent, pruned) tape, whatever thread runs it.
+
+#include "FRep/Evaluators.h"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+
+namespace ictk::frep
+{
+
+/// A regular grid of the modelling space; x varies fastest (VTK's point order).
+struct Grid
+{
+  std::array<double, 3> origin{ 0, 0, 0 };
+  std::array<double, 3> spacing{ 1, 1, 1 };
+  std::array<std::int64_t, 3> dimensions{ 0, 0, 0 };
+  double time = 0;
+  std::int64_t pointCount() const { return dimensions[0] * dimensions[1] * dimensions[2]; }
+};
+
+/// A grid that covers [lo, hi] with `resolution` points per axis (corners included).
+Grid gridOverBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi,
+  const std::array<std::int64_t, 3>& resolution, double time = 0);
+
+/// Throws std::invalid_argument when the grid is empty, has a non-finite or non-positive spacing,
+/// or would need more than `maxBytes` for `bytesPerPoint` values per point (default: 80 % of the
+/// physical memory).
+void checkGrid(const Grid& grid, std::size_t bytesPerPoint, std::size_t maxBytes = 0);
+
+/// Raised when the progress callback asks to stop.
+class Cancelled : public std::runtime_error
+{
+public:
+  Cancelled()
+    : std::runtime_error("cancelled")
+  {
+  }
+};
+
+struct SampleOptions
+{
+  /// Threads to use; 0 = TBB's default.
+  int threads = 0;
+  /// Simplify the tape per brick by interval arithmetic (same values, fewer instructions).
+  bool prune = true;
+  /// Edge of the cubic bricks the grid is split into.
+  int brickSize = 16;
+  /// Called with the completed fraction; return false to cancel (sampleGrid then throws Cancelled).
+  std::function<bool(double)> progress;
+  std::vector<double> parameters;
+};
+
+/// Fills `out` (grid.pointCount() values) with the tape's first output.
+void sampleGrid(const TapePtr& tape, const Grid& grid, float* out, const SampleOptions& options = {});
+void sampleGrid(const TapePtr& tape, const Grid& grid, double* out, const SampleOptions& options = {});
+
+} // namespace ictk::frep

@@ -1,0 +1,409 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Agreement of the four evaluators over random expression trees, tape simplification, sampling.
+#include "FRep/Evaluators.h"
+#include "FRep/Hypervolume.h"
+#include "FRep/Sampling.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+using namespace ictk::frep;
+
+namespace
+{
+// A portable uniform mapping (std::uniform_real_distribution differs between standard libraries).
+struct Random
+{
+  explicit Random(unsigned seed)
+    : engine(seed)
+  {
+  }
+  double uniform(double lo, double hi)
+  {
+    return lo + (hi - lo) * (static_cast<double>(engine() >> 11) * 0x1.0p-53);
+  }
+  int index(int n) { return static_cast<int>(engine() % static_cast<std::uint64_t>(n)); }
+  std::mt19937_64 engine;
+};
+
+// Random trees. `smooth` restricts to everywhere-differentiable operations (for finite
+// differences); otherwise every opcode appears, including the ones that make NaN.
+Expr randomTree(Random& rng, int depth, bool smooth)
+{
+  if (depth == 0 || rng.index(5) == 0)
+  {
+    switch (rng.index(5))
+    {
+      case 0:
+        return Expr::x();
+      case 1:
+        return Expr::y();
+      case 2:
+        return Expr::z();
+      case 3:
+        return Expr::t();
+      default:
+        return Expr(std::round(rng.uniform(-3, 3) * 8) / 8);
+    }
+  }
+  const Expr a = randomTree(rng, depth - 1, smooth);
+  const Expr b = randomTree(rng, depth - 1, smooth);
+  if (smooth)
+  {
+    switch (rng.index(8))
+    {
+      case 0:
+        return a + b;
+      case 1:
+        return a - b;
+      case 2:
+        return a * b;
+      case 3:
+        return sin(a);
+      case 4:
+        return cos(b);
+      case 5:
+        return atan(a);
+      case 6:
+        return sqrt(1.0 + square(a));
+      default:
+        return exp(sin(a)) * b;
+    }
+  }
+  const Expr c = randomTree(rng, depth - 1, smooth);
+  static const Opcode unary[] = { Opcode::Neg, Opcode::Abs, Opcode::Sqrt, Opcode::Square,
+    Opcode::Exp, Opcode::Log, Opcode::Sin, Opcode::Cos, Opcode::Tan, Opcode::Asin, Opcode::Acos,
+    Opcode::Atan, Opcode::Sign };
+  static const Opcode binary[] = { Opcode::Add, Opcode::Sub, Opcode::Mul, Opcode::Div, Opcode::Min,
+    Opcode::Max, Opcode::Pow, Opcode::Atan2 };
+  switch (rng.index(4))
+  {
+    case 0:
+      return Expr::make(unary[rng.index(13)], a);
+    case 1:
+      return select(a, b, c);
+    default:
+      return Expr::make(binary[rng.index(8)], a, b);
+  }
+}
+
+bool sameDouble(double a, double b)
+{
+  return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b));
+}
+
+constexpr int TreeCount = 300;
+} // namespace
+
+TEST(Evaluators, PointAndBatchMatchTheReferenceBitForBit)
+{
+  Random rng(1);
+  for (int n = 0; n < TreeCount; ++n)
+  {
+    const Expr e = randomTree(rng, 6, false);
+    const TapePtr tape = Tape::compile(e);
+    PointEvaluator point(tape);
+    BatchEvaluator<double> batch(tape);
+    std::vector<double> xs(300), ys(300), zs(300), ts(300), out(300);
+    for (std::size_t i = 0; i < xs.size(); ++i)
+    {
+      xs[i] = rng.uniform(-4, 4);
+      ys[i] = rng.uniform(-4, 4);
+      zs[i] = rng.uniform(-4, 4);
+      ts[i] = rng.uniform(-4, 4);
+    }
+    batch.eval(xs.data(), ys.data(), zs.data(), ts.data(), out.data(), xs.size());
+    for (std::size_t i = 0; i < xs.size(); ++i)
+    {
+      const double ref = evaluateReference(e, { xs[i], ys[i], zs[i], ts[i] });
+      const double p = point.eval(xs[i], ys[i], zs[i], ts[i]);
+      ASSERT_TRUE(sameDouble(ref, p)) << toString(e) << " ref " << ref << " point " << p;
+      ASSERT_TRUE(sameDouble(p, out[i])) << toString(e) << " point " << p << " batch " << out[i];
+    }
+  }
+}
+
+TEST(Evaluators, RowEvaluationMatchesPointEvaluation)
+{
+  Random rng(2);
+  for (int n = 0; n < TreeCount; ++n)
+  {
+    const Expr e = randomTree(rng, 6, false);
+    const TapePtr tape = Tape::compile(e);
+    PointEvaluator point(tape);
+    BatchEvaluator<double> batch(tape);
+    BatchEvaluator<float> batchF(tape);
+    const double x0 = rng.uniform(-3, 0), dx = 0.013, y = rng.uniform(-3, 3), z = rng.uniform(-3, 3),
+                 t = rng.uniform(-3, 3);
+    std::vector<double> row(600);
+    std::vector<float> rowF(600);
+    batch.evalRowX(x0, dx, 0, y, z, t, row.data(), row.size());
+    batchF.evalRowX(x0, dx, 0, y, z, t, rowF.data(), rowF.size());
+    std::vector<float> xs(600), ys(600, float(y)), zs(600, float(z)), ts(600, float(t)), outF(600);
+    for (std::size_t i = 0; i < row.size(); ++i)
+    {
+      xs[i] = static_cast<float>(x0 + static_cast<double>(i) * dx);
+    }
+    batchF.eval(xs.data(), ys.data(), zs.data(), ts.data(), outF.data(), xs.size());
+    for (std::size_t i = 0; i < row.size(); ++i)
+    {
+      const double p = point.eval(x0 + static_cast<double>(i) * dx, y, z, t);
+      ASSERT_TRUE(sameDouble(p, row[i])) << toString(e) << " at i=" << i;
+      // Float rows and float batches run the same float arithmetic.
+      ASSERT_TRUE(std::memcmp(&rowF[i], &outF[i], sizeof(float)) == 0 ||
+        (std::isnan(rowF[i]) && std::isnan(outF[i])))
+        << toString(e) << " row " << rowF[i] << " batch " << outF[i];
+    }
+  }
+}
+
+TEST(Evaluators, FloatBatchIsCloseToDouble)
+{
+  Random rng(3);
+  for (int n = 0; n < TreeCount; ++n)
+  {
+    const Expr e = randomTree(rng, 4, true);
+    const TapePtr tape = Tape::compile(e);
+    PointEvaluator point(tape);
+    BatchEvaluator<float> batch(tape);
+    std::vector<float> xs(64), ys(64), zs(64), ts(64), out(64);
+    for (std::size_t i = 0; i < xs.size(); ++i)
+    {
+      xs[i] = static_cast<float>(rng.uniform(-2, 2));
+      ys[i] = static_cast<float>(rng.uniform(-2, 2));
+      zs[i] = static_cast<float>(rng.uniform(-2, 2));
+      ts[i] = static_cast<float>(rng.uniform(-2, 2));
+    }
+    batch.eval(xs.data(), ys.data(), zs.data(), ts.data(), out.data(), xs.size());
+    for (std::size_t i = 0; i < xs.size(); ++i)
+    {
+      const double p = point.eval(xs[i], ys[i], zs[i], ts[i]);
+      if (std::isfinite(p) && std::fabs(p) < 1e6)
+      {
+        EXPECT_NEAR(out[i], p, 1e-3 * (1 + std::fabs(p))) << toString(e);
+      }
+    }
+  }
+}
+
+TEST(Evaluators, GradientMatchesFiniteDifferences)
+{
+  Random rng(4);
+  for (int n = 0; n < TreeCount; ++n)
+  {
+    const Expr e = randomTree(rng, 5, true);
+    const TapePtr tape = Tape::compile(e);
+    PointEvaluator point(tape);
+    GradientEvaluator grad(tape);
+    for (int s = 0; s < 10; ++s)
+    {
+      std::array<double, 4> p{ rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2),
+        rng.uniform(-2, 2) };
+      const ValueGradient g = grad.eval(p[0], p[1], p[2], p[3]);
+      ASSERT_TRUE(sameDouble(g.value, point.eval(p[0], p[1], p[2], p[3])));
+      for (int a = 0; a < 4; ++a)
+      {
+        const double h = 1e-5;
+        auto q = p, r = p;
+        q[a] += h;
+        r[a] -= h;
+        const double fd = (point.eval(q[0], q[1], q[2], q[3]) - point.eval(r[0], r[1], r[2], r[3])) / (2 * h);
+        if (std::isfinite(fd) && std::fabs(fd) < 1e4)
+        {
+          EXPECT_NEAR(g.gradient[a], fd, 1e-4 * (1 + std::fabs(fd))) << toString(e) << " axis " << a;
+        }
+      }
+    }
+  }
+}
+
+TEST(Evaluators, GradientOfSphereGivesOutwardNormal)
+{
+  // f = 1 - x^2 - y^2 - z^2: grad f = (-2x, -2y, -2z); n = -grad/|grad| points outward.
+  const Expr f = Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z());
+  GradientEvaluator grad(Tape::compile(f));
+  const ValueGradient g = grad.eval(0.6, 0.0, 0.8);
+  EXPECT_NEAR(g.value, 0.0, 1e-15); // 1 - 0.36 - 0.64 rounds to -1.1e-16
+  EXPECT_DOUBLE_EQ(g.gradient[0], -1.2);
+  EXPECT_DOUBLE_EQ(g.gradient[2], -1.6);
+  const auto n = outwardNormal(g);
+  EXPECT_NEAR(n[0], 0.6, 1e-15);
+  EXPECT_NEAR(n[1], 0.0, 1e-15);
+  EXPECT_NEAR(n[2], 0.8, 1e-15);
+}
+
+TEST(Evaluators, IntervalsEnclosePointSamplesAndPruningKeepsValues)
+{
+  Random rng(5);
+  std::size_t cut = 0, total = 0;
+  for (int n = 0; n < TreeCount; ++n)
+  {
+    const Expr e = randomTree(rng, 6, false);
+    const TapePtr tape = Tape::compile(e);
+    IntervalEvaluator interval(tape);
+    PointEvaluator point(tape);
+    for (int r = 0; r < 8; ++r)
+    {
+      Region region;
+      for (auto& axis : region.axes)
+      {
+        const double c = rng.uniform(-3, 3), w = rng.uniform(0, r < 4 ? 0.1 : 2.0);
+        axis = { c - w, c + w };
+      }
+      const Interval range = interval.eval(region);
+      const TapePtr pruned = interval.simplified();
+      total += tape->instructions().size();
+      cut += tape->instructions().size() - pruned->instructions().size();
+      PointEvaluator prunedPoint(pruned);
+      for (int s = 0; s < 50; ++s)
+      {
+        std::array<double, 4> p;
+        for (int a = 0; a < 4; ++a)
+        {
+          p[a] = s == 0 ? region.axes[a].lo : (s == 1 ? region.axes[a].hi : rng.uniform(region.axes[a].lo, region.axes[a].hi));
+        }
+        const double v = point.eval(p[0], p[1], p[2], p[3]);
+        if (std::isfinite(v))
+        {
+          ASSERT_LE(range.lo, v) << toString(e);
+          ASSERT_GE(range.hi, v) << toString(e);
+        }
+        ASSERT_TRUE(sameDouble(v, prunedPoint.eval(p[0], p[1], p[2], p[3]))) << toString(e);
+      }
+    }
+  }
+  // The property is only meaningful if pruning happens: random min/max/select trees lose
+  // instructions in small regions.
+  EXPECT_GT(cut, total / 50) << "cut " << cut << " of " << total;
+}
+
+TEST(Evaluators, PruningCutsTheLosingBranchOfAUnion)
+{
+  // max(sphere at -2, sphere at +2): near x = +2 only the second sphere matters.
+  const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
+  const Expr left = Expr(1.0) - square(x + 2.0) - square(y) - square(z);
+  const Expr right = Expr(1.0) - square(x - 2.0) - square(y) - square(z);
+  const TapePtr tape = Tape::compile(max(left, right));
+  IntervalEvaluator interval(tape);
+  Region region;
+  region.axes = { Interval{ 1.5, 2.5 }, Interval{ -0.5, 0.5 }, Interval{ -0.5, 0.5 }, Interval{ 0, 0 } };
+  const Interval r = interval.eval(region);
+  EXPECT_EQ(interval.choices().back(), Choice::Second);
+  const TapePtr pruned = interval.simplified();
+  EXPECT_LT(pruned->instructions().size(), tape->instructions().size());
+  EXPECT_TRUE(r.contains(1.0));
+  PointEvaluator p(pruned);
+  EXPECT_DOUBLE_EQ(p.eval(2, 0, 0), 1.0);
+}
+
+TEST(Evaluators, MultipleOutputsAndParameters)
+{
+  const Expr r = Expr::parameter(0);
+  const TapePtr tape = Tape::compile({ square(r) - square(Expr::x()), Expr::x() * 2.0, Expr(5.0) });
+  PointEvaluator p(tape, { 3.0 });
+  std::array<double, 3> out;
+  p.evalAll({ 1, 0, 0, 0 }, out.data());
+  EXPECT_EQ(out[0], 8.0);
+  EXPECT_EQ(out[1], 2.0);
+  EXPECT_EQ(out[2], 5.0);
+  p.setParameters({ 1.0 });
+  EXPECT_EQ(p.eval(1, 0, 0), 0.0);
+  EXPECT_THROW(PointEvaluator(tape, {}), std::invalid_argument);
+}
+
+TEST(Hypervolume, AttributeDefaultsFollowTheConsistentReadingOfL715)
+{
+  // Unit sphere with a density partition g = x (only the half x >= 0 has the function S = 10 + z).
+  const Shape ball(Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "ball");
+  Hypervolume hv(ball);
+  Attribute density;
+  density.name = "density";
+  density.components = { Expr(10.0) + Expr::z() };
+  density.partition = Expr::x();
+  density.insideDefault = { 1.0 };   // theta1
+  density.outsideDefault = { -1.0 }; // theta0
+  hv.addAttribute(density);
+  HypervolumeEvaluator ev(hv);
+  double f, a;
+  ev.eval({ 0.5, 0, 0.25, 0 }, f, &a); // g >= 0: S
+  EXPECT_DOUBLE_EQ(f, 0.6875);
+  EXPECT_DOUBLE_EQ(a, 10.25);
+  ev.eval({ 3.0, 0, 0.0, 0 }, f, &a); // g >= 0 outside the ball: still S (case 1 of L715)
+  EXPECT_DOUBLE_EQ(a, 10.0);
+  ev.eval({ -0.5, 0, 0, 0 }, f, &a); // inside, g < 0: theta1
+  EXPECT_DOUBLE_EQ(a, 1.0);
+  ev.eval({ -3.0, 0, 0, 0 }, f, &a); // outside, g < 0: theta0
+  EXPECT_DOUBLE_EQ(a, -1.0);
+  // Point membership, thesis eq. 2 (L673-L677).
+  EXPECT_EQ(ev.membership({ 0, 0, 0, 0 }), 2);
+  EXPECT_EQ(ev.membership({ 1, 0, 0, 0 }), 1);
+  EXPECT_EQ(ev.membership({ 2, 0, 0, 0 }), 0);
+  EXPECT_THROW(hv.addAttribute(density), std::invalid_argument);
+  Attribute colour;
+  colour.name = "colour";
+  colour.components = { Expr(1.0), Expr(0.5), Expr::t() };
+  EXPECT_THROW(hv.addAttribute(colour), std::invalid_argument); // t is outside XYZ
+}
+
+TEST(Sampling, GridValuesEqualPointEvaluationForAnyThreadCount)
+{
+  Random rng(6);
+  const Expr e = max(randomTree(rng, 7, false), min(Expr(1.0) - square(Expr::x()) - square(Expr::y()),
+                                                  Expr(0.5) - square(Expr::z())));
+  const TapePtr tape = Tape::compile(e);
+  const Grid grid = gridOverBox({ -2, -2, -2 }, { 2, 2, 2 }, { 37, 29, 23 }, 0.25);
+  std::vector<double> one(grid.pointCount()), two(grid.pointCount()), flat(grid.pointCount());
+  SampleOptions options;
+  options.threads = 1;
+  options.brickSize = 8;
+  sampleGrid(tape, grid, one.data(), options);
+  options.threads = 2;
+  sampleGrid(tape, grid, two.data(), options);
+  options.prune = false;
+  sampleGrid(tape, grid, flat.data(), options);
+  PointEvaluator point(tape);
+  for (std::int64_t k = 0; k < grid.dimensions[2]; ++k)
+    for (std::int64_t j = 0; j < grid.dimensions[1]; ++j)
+      for (std::int64_t i = 0; i < grid.dimensions[0]; ++i)
+      {
+        const std::size_t idx = static_cast<std::size_t>((k * grid.dimensions[1] + j) * grid.dimensions[0] + i);
+        const double v = point.eval(grid.origin[0] + i * grid.spacing[0],
+          grid.origin[1] + j * grid.spacing[1], grid.origin[2] + k * grid.spacing[2], 0.25);
+        ASSERT_TRUE(sameDouble(v, one[idx])) << i << " " << j << " " << k;
+        ASSERT_TRUE(sameDouble(one[idx], two[idx]));
+        ASSERT_TRUE(sameDouble(one[idx], flat[idx]));
+      }
+}
+
+TEST(Sampling, BadGridsAndCancellation)
+{
+  const TapePtr tape = Tape::compile(Expr(1.0) - square(Expr::x()));
+  std::vector<float> out(8);
+  Grid empty = gridOverBox({ 0, 0, 0 }, { 1, 1, 1 }, { 0, 2, 2 });
+  EXPECT_THROW(sampleGrid(tape, empty, out.data()), std::invalid_argument);
+  Grid nan = gridOverBox({ 0, 0, 0 }, { 1, 1, 1 }, { 2, 2, 2 });
+  nan.spacing[1] = std::nan("");
+  EXPECT_THROW(sampleGrid(tape, nan, out.data()), std::invalid_argument);
+  // 100000^3 floats are 4 PB: refused before any allocation.
+  const Grid huge = gridOverBox({ 0, 0, 0 }, { 1, 1, 1 }, { 100000, 100000, 100000 });
+  try
+  {
+    checkGrid(huge, sizeof(float));
+    FAIL();
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("GB"), std::string::npos) << e.what();
+  }
+  const Grid grid = gridOverBox({ -1, -1, -1 }, { 1, 1, 1 }, { 64, 64, 64 });
+  std::vector<float> big(grid.pointCount());
+  SampleOptions options;
+  options.brickSize = 4;
+  int calls = 0;
+  options.progress = [&](double) { return ++calls < 3; };
+  EXPECT_THROW(sampleGrid(tape, grid, big.data(), options), Cancelled);
+  EXPECT_EQ(calls, 3);
+}
