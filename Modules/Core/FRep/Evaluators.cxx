@@ -148,6 +148,10 @@ void BatchEvaluator<T>::setTape(TapePtr tape)
   {
     throw std::invalid_argument("BatchEvaluator::setTape: the new tape needs more parameters");
   }
+  if (tape == tape_)
+  {
+    return;
+  }
   tape_ = std::move(tape);
   prepare();
 }
@@ -229,7 +233,7 @@ void BatchEvaluator<T>::evalRowX(
   T* storage = rowStorage_.data();
   for (const auto& [scalar, chunk] : row_.broadcasts)
   {
-    std::fill_n(storage + chunk * ChunkSize, ChunkSize, s[scalar]);
+    std::fill_n(storage + chunk * ChunkSize, std::min(n, ChunkSize), s[scalar]);
   }
   T* xs = storage + row_.axisSlots[0] * ChunkSize;
   for (std::size_t start = 0; start < n; start += ChunkSize)

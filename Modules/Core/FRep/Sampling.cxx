@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <memory>
 #include <thread>
 
 namespace ictk::frep
@@ -89,16 +90,46 @@ void checkGrid(const Grid& grid, std::size_t bytesPerPoint, std::size_t maxBytes
 
 namespace
 {
+// Per-thread evaluation state. Neighbouring bricks usually prune to the same tape, so the
+// evaluators prepared for the last few sets of choices are kept (simplifying and preparing a
+// tape costs about as much as evaluating a small brick).
 template <typename T>
 struct Workspace
 {
+  static constexpr std::size_t CacheSize = 16;
+
   Workspace(const TapePtr& tape, const std::vector<double>& parameters)
-    : batch(tape, parameters)
+    : full(tape, parameters)
     , interval(tape, parameters)
+    , parameters(parameters)
   {
   }
-  BatchEvaluator<T> batch;
+
+  BatchEvaluator<T>& evaluatorFor(const std::vector<Choice>& choices)
+  {
+    for (auto& entry : cache)
+    {
+      if (entry.first == choices)
+      {
+        return *entry.second;
+      }
+    }
+    auto evaluator = std::make_unique<BatchEvaluator<T>>(interval.simplified(), parameters);
+    if (cache.size() < CacheSize)
+    {
+      cache.emplace_back(choices, std::move(evaluator));
+      return *cache.back().second;
+    }
+    auto& victim = cache[next++ % CacheSize];
+    victim = { choices, std::move(evaluator) };
+    return *victim.second;
+  }
+
+  BatchEvaluator<T> full;
   IntervalEvaluator interval;
+  std::vector<double> parameters;
+  std::vector<std::pair<std::vector<Choice>, std::unique_ptr<BatchEvaluator<T>>>> cache;
+  std::size_t next = 0;
 };
 
 template <typename T>
@@ -111,12 +142,14 @@ void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& 
       std::to_string(tape->parameterCount()) + " parameter(s) but " +
       std::to_string(options.parameters.size()) + " value(s) were given");
   }
-  const std::int64_t brick = std::max(1, options.brickSize);
+  // Bricks are longer along x, the row direction, so that per-row work is amortised.
+  const std::int64_t edge = std::max(1, options.brickSize);
+  const std::array<std::int64_t, 3> brick{ 4 * edge, edge, edge };
   const auto& dims = grid.dimensions;
   std::array<std::int64_t, 3> bricks;
   for (int a = 0; a < 3; ++a)
   {
-    bricks[a] = (dims[a] + brick - 1) / brick;
+    bricks[a] = (dims[a] + brick[a] - 1) / brick[a];
   }
   const std::int64_t brickCount = bricks[0] * bricks[1] * bricks[2];
 
@@ -136,9 +169,10 @@ void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& 
     }
     Workspace<T>& ws = *slot;
     const std::int64_t bi = b % bricks[0], bj = (b / bricks[0]) % bricks[1], bk = b / (bricks[0] * bricks[1]);
-    const std::int64_t i0 = bi * brick, j0 = bj * brick, k0 = bk * brick;
-    const std::int64_t i1 = std::min(dims[0], i0 + brick), j1 = std::min(dims[1], j0 + brick),
-                       k1 = std::min(dims[2], k0 + brick);
+    const std::int64_t i0 = bi * brick[0], j0 = bj * brick[1], k0 = bk * brick[2];
+    const std::int64_t i1 = std::min(dims[0], i0 + brick[0]), j1 = std::min(dims[1], j0 + brick[1]),
+                       k1 = std::min(dims[2], k0 + brick[2]);
+    BatchEvaluator<T>* evaluator = &ws.full;
     if (options.prune)
     {
       Region region;
@@ -147,7 +181,7 @@ void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& 
       region.axes[2] = { grid.origin[2] + k0 * grid.spacing[2], grid.origin[2] + (k1 - 1) * grid.spacing[2] };
       region.axes[3] = { grid.time, grid.time };
       ws.interval.eval(region);
-      ws.batch.setTape(ws.interval.simplified());
+      evaluator = &ws.evaluatorFor(ws.interval.choices());
     }
     for (std::int64_t k = k0; k < k1; ++k)
     {
@@ -156,7 +190,7 @@ void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& 
       {
         const double y = grid.origin[1] + j * grid.spacing[1];
         T* row = out + (k * dims[1] + j) * dims[0] + i0;
-        ws.batch.evalRowX(grid.origin[0], grid.spacing[0], i0, y, z, grid.time, row,
+        evaluator->evalRowX(grid.origin[0], grid.spacing[0], i0, y, z, grid.time, row,
           static_cast<std::size_t>(i1 - i0));
       }
     }
