@@ -8,6 +8,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace ictk::frep
 {
@@ -80,7 +81,8 @@ namespace
 // One instruction over n points. Every case is a plain loop over non-aliasing arrays (the register
 // allocator never gives an instruction its own input slot), so the compiler vectorises them.
 template <typename T>
-void runChunk(const std::vector<Instruction>& code, T* storage, std::size_t stride, std::size_t n)
+__attribute__((always_inline)) inline void runChunkImpl(
+  const std::vector<Instruction>& code, T* storage, std::size_t stride, std::size_t n)
 {
   for (const Instruction& ins : code)
   {
@@ -123,6 +125,35 @@ void runChunk(const std::vector<Instruction>& code, T* storage, std::size_t stri
     }
 #undef ICTK_LOOP
   }
+}
+
+// The kernels are compiled for several instruction sets and picked at load time (GCC function
+// multi-versioning), so one portable binary uses AVX2/AVX-512 where the CPU has them.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define ICTK_TARGET_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define ICTK_TARGET_CLONES
+#endif
+
+ICTK_TARGET_CLONES void runChunkFloat(
+  const std::vector<Instruction>& code, float* storage, std::size_t stride, std::size_t n)
+{
+  runChunkImpl<float>(code, storage, stride, n);
+}
+
+ICTK_TARGET_CLONES void runChunkDouble(
+  const std::vector<Instruction>& code, double* storage, std::size_t stride, std::size_t n)
+{
+  runChunkImpl<double>(code, storage, stride, n);
+}
+
+template <typename T>
+void runChunk(const std::vector<Instruction>& code, T* storage, std::size_t stride, std::size_t n)
+{
+  if constexpr (std::is_same_v<T, float>)
+    runChunkFloat(code, storage, stride, n);
+  else
+    runChunkDouble(code, storage, stride, n);
 }
 } // namespace
 
