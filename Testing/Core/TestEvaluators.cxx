@@ -407,3 +407,19 @@ TEST(Sampling, BadGridsAndCancellation)
   EXPECT_THROW(sampleGrid(tape, grid, big.data(), options), Cancelled);
   EXPECT_EQ(calls, 3);
 }
+
+TEST(Evaluators, RUnionAtTheZeroSetIsNotFlaggedNaN)
+{
+  // f1 + f2 + sqrt(f1^2 + f2^2) over a region containing f1 = f2 = 0: the sqrt argument is a sum of
+  // squares, so no point can give NaN and pruning stays possible.
+  const Expr f1 = Expr::x(), f2 = Expr::y();
+  const TapePtr tape = Tape::compile(f1 + f2 + sqrt(square(f1) + square(f2)));
+  IntervalEvaluator interval(tape);
+  Region region;
+  region.axes = { Interval{ -1, 1 }, Interval{ -1, 1 }, Interval{ 0, 0 }, Interval{ 0, 0 } };
+  const Interval r = interval.eval(region);
+  EXPECT_FALSE(r.maybeNaN);
+  // True range over the square: from -2 + sqrt(2) at (-1, -1) to 2 + sqrt(2) at (1, 1).
+  EXPECT_LE(r.lo, -2.0 + std::sqrt(2.0));
+  EXPECT_GE(r.hi, 2.0 + std::sqrt(2.0));
+}

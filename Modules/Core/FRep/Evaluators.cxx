@@ -296,6 +296,14 @@ Interval widen(Interval r)
   return { std::nextafter(r.lo, -inf), std::nextafter(r.hi, inf), r.maybeNaN };
 }
 
+// Widening must not push a bound below zero when the result cannot be negative (a square, a sum
+// of squares): sqrt would then report possible NaN and pruning would be needlessly cautious.
+Interval nonNegative(Interval r)
+{
+  r.lo = std::max(r.lo, 0.0);
+  return r;
+}
+
 Interval nowhere()
 {
   return { inf, -inf, true };
@@ -328,16 +336,18 @@ Interval mul(const Interval& a, const Interval& b)
     hi = std::max(hi, v);
   }
   const bool zeroTimesInf = (a.contains(0) && hasInfinity(b)) || (b.contains(0) && hasInfinity(a));
-  return widen({ lo, hi, a.maybeNaN || b.maybeNaN || zeroTimesInf });
+  const Interval r = widen({ lo, hi, a.maybeNaN || b.maybeNaN || zeroTimesInf });
+  const bool sameSign = (a.lo >= 0 && b.lo >= 0) || (a.hi <= 0 && b.hi <= 0);
+  return sameSign ? nonNegative(r) : r;
 }
 
 Interval squareRange(const Interval& a)
 {
   if (a.lo >= 0)
-    return widen({ a.lo * a.lo, a.hi * a.hi, a.maybeNaN });
+    return nonNegative(widen({ a.lo * a.lo, a.hi * a.hi, a.maybeNaN }));
   if (a.hi <= 0)
-    return widen({ a.hi * a.hi, a.lo * a.lo, a.maybeNaN });
-  return widen({ 0.0, std::max(a.lo * a.lo, a.hi * a.hi), a.maybeNaN });
+    return nonNegative(widen({ a.hi * a.hi, a.lo * a.lo, a.maybeNaN }));
+  return nonNegative(widen({ 0.0, std::max(a.lo * a.lo, a.hi * a.hi), a.maybeNaN }));
 }
 
 // Range of sin or cos over [lo, hi]: the extremes are at the ends or at the maxima (sin: pi/2 +
@@ -451,11 +461,12 @@ Interval intervalOp(Opcode op, const Interval& a, const Interval& b, const Inter
     case Opcode::Sqrt:
       if (a.hi < 0)
         return nowhere();
-      return widen({ std::sqrt(std::max(a.lo, 0.0)), std::sqrt(a.hi), a.maybeNaN || a.lo < 0 });
+      return nonNegative(
+        widen({ std::sqrt(std::max(a.lo, 0.0)), std::sqrt(a.hi), a.maybeNaN || a.lo < 0 }));
     case Opcode::Square:
       return squareRange(a);
     case Opcode::Exp:
-      return monotoneIncreasing(std::exp, a);
+      return nonNegative(monotoneIncreasing(std::exp, a));
     case Opcode::Log:
       if (a.hi < 0)
         return nowhere();
@@ -493,7 +504,7 @@ Interval intervalOp(Opcode op, const Interval& a, const Interval& b, const Inter
       Interval r = widen({ a.lo + b.lo, a.hi + b.hi, nanIn || infMinusInf });
       if (std::isnan(r.lo) || std::isnan(r.hi))
         return { -inf, inf, true };
-      return r;
+      return a.lo >= 0 && b.lo >= 0 ? nonNegative(r) : r;
     }
     case Opcode::Sub:
     {
