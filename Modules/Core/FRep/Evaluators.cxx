@@ -82,14 +82,14 @@ namespace
 // allocator never gives an instruction its own input slot), so the compiler vectorises them.
 template <typename T>
 __attribute__((always_inline)) inline void runChunkImpl(
-  const std::vector<Instruction>& code, T* storage, std::size_t stride, std::size_t n)
+  const std::vector<Instruction>& code, T* const* slot, std::size_t n)
 {
   for (const Instruction& ins : code)
   {
-    T* __restrict o = storage + ins.out * stride;
-    const T* __restrict a = storage + ins.a * stride;
-    const T* __restrict b = storage + ins.b * stride;
-    const T* __restrict c = storage + ins.c * stride;
+    T* __restrict o = slot[ins.out];
+    const T* __restrict a = slot[ins.a];
+    const T* __restrict b = slot[ins.b];
+    const T* __restrict c = slot[ins.c];
 #define ICTK_LOOP(expr)                                                                            \
   for (std::size_t i = 0; i < n; ++i)                                                              \
   {                                                                                                \
@@ -136,24 +136,24 @@ __attribute__((always_inline)) inline void runChunkImpl(
 #endif
 
 ICTK_TARGET_CLONES void runChunkFloat(
-  const std::vector<Instruction>& code, float* storage, std::size_t stride, std::size_t n)
+  const std::vector<Instruction>& code, float* const* slot, std::size_t n)
 {
-  runChunkImpl<float>(code, storage, stride, n);
+  runChunkImpl<float>(code, slot, n);
 }
 
 ICTK_TARGET_CLONES void runChunkDouble(
-  const std::vector<Instruction>& code, double* storage, std::size_t stride, std::size_t n)
+  const std::vector<Instruction>& code, double* const* slot, std::size_t n)
 {
-  runChunkImpl<double>(code, storage, stride, n);
+  runChunkImpl<double>(code, slot, n);
 }
 
 template <typename T>
-void runChunk(const std::vector<Instruction>& code, T* storage, std::size_t stride, std::size_t n)
+void runChunk(const std::vector<Instruction>& code, T* const* slot, std::size_t n)
 {
   if constexpr (std::is_same_v<T, float>)
-    runChunkFloat(code, storage, stride, n);
+    runChunkFloat(code, slot, n);
   else
-    runChunkDouble(code, storage, stride, n);
+    runChunkDouble(code, slot, n);
 }
 } // namespace
 
@@ -193,8 +193,13 @@ void BatchEvaluator<T>::prepare()
   const Tape& tape = *tape_;
   // Full tape: leaves in fixed slots, constants and parameters broadcast once.
   storage_.assign(static_cast<std::size_t>(tape.slotCount()) * ChunkSize, T(0));
+  slots_.resize(tape.slotCount());
+  for (std::uint32_t i = 0; i < tape.slotCount(); ++i)
+  {
+    slots_[i] = storage_.data() + static_cast<std::size_t>(i) * ChunkSize;
+  }
   auto fill = [&](std::uint32_t slot, double v)
-  { std::fill_n(storage_.begin() + slot * ChunkSize, ChunkSize, static_cast<T>(v)); };
+  { std::fill_n(slots_[slot], ChunkSize, static_cast<T>(v)); };
   for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
   {
     fill(tape.parameterBase() + i, parameters_[i]);
@@ -206,6 +211,11 @@ void BatchEvaluator<T>::prepare()
   // Row program along x.
   row_ = tape.rowProgram(1u << static_cast<int>(Axis::X));
   rowStorage_.assign(static_cast<std::size_t>(row_.chunkSlotCount) * ChunkSize, T(0));
+  rowSlots_.resize(row_.chunkSlotCount);
+  for (std::uint32_t i = 0; i < row_.chunkSlotCount; ++i)
+  {
+    rowSlots_[i] = rowStorage_.data() + static_cast<std::size_t>(i) * ChunkSize;
+  }
   scalars_.assign(row_.scalarSlotCount, T(0));
   for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
   {
@@ -215,6 +225,14 @@ void BatchEvaluator<T>::prepare()
   {
     scalars_[tape.constantBase() + i] = static_cast<T>(tape.constants()[i]);
   }
+  // Values that depend on no coordinate are the same for every row: broadcast them now (the
+  // uniform code computes them whatever the coordinates are).
+  runScalar(row_.uniform, scalars_.data());
+  for (const auto& [scalar, chunk] : row_.fixedBroadcasts)
+  {
+    std::fill_n(rowSlots_[chunk], ChunkSize, scalars_[scalar]);
+  }
+  rowX_ = { 0, 0, -1, 0 };
 }
 
 template <typename T>
@@ -233,15 +251,14 @@ void BatchEvaluator<T>::eval(const T* x, const T* y, const T* z, const T* t, T* 
   for (std::size_t start = 0; start < n; start += ChunkSize)
   {
     const std::size_t m = std::min(ChunkSize, n - start);
+    // Inputs are read in place: no instruction writes an input slot. (Writing the output in place
+    // as well was measured slower: temporaries sharing its slot then go to the large array.)
     for (int a = 0; a < 4; ++a)
     {
-      if (inputs[a])
-      {
-        std::copy_n(inputs[a] + start, m, storage_.begin() + a * ChunkSize);
-      }
+      slots_[a] = inputs[a] ? const_cast<T*>(inputs[a] + start) : storage_.data() + a * ChunkSize;
     }
-    runChunk<T>(tape_->instructions(), storage_.data(), ChunkSize, m);
-    std::copy_n(storage_.begin() + outSlot * ChunkSize, m, out + start);
+    runChunk<T>(tape_->instructions(), slots_.data(), m);
+    std::copy_n(slots_[outSlot], m, out + start);
   }
 }
 
@@ -261,22 +278,27 @@ void BatchEvaluator<T>::evalRowX(
     std::fill_n(out, n, s[output.slot]);
     return;
   }
-  T* storage = rowStorage_.data();
   for (const auto& [scalar, chunk] : row_.broadcasts)
   {
-    std::fill_n(storage + chunk * ChunkSize, std::min(n, ChunkSize), s[scalar]);
+    std::fill_n(rowSlots_[chunk], std::min(n, ChunkSize), s[scalar]);
   }
-  T* xs = storage + row_.axisSlots[0] * ChunkSize;
+  T* xs = rowSlots_[row_.axisSlots[0]];
   for (std::size_t start = 0; start < n; start += ChunkSize)
   {
     const std::size_t m = std::min(ChunkSize, n - start);
-    for (std::size_t i = 0; i < m; ++i)
+    // Rows of one brick share their x coordinates: fill them only when they change.
+    const RowX key{ x0, dx, first + static_cast<std::int64_t>(start), m };
+    if (!(key == rowX_))
     {
-      // Coordinates in double, as every other evaluator receives them.
-      xs[i] = static_cast<T>(x0 + static_cast<double>(first + static_cast<std::int64_t>(start + i)) * dx);
+      for (std::size_t i = 0; i < m; ++i)
+      {
+        // Coordinates in double, as every other evaluator receives them.
+        xs[i] = static_cast<T>(x0 + static_cast<double>(key.first + static_cast<std::int64_t>(i)) * dx);
+      }
+      rowX_ = key;
     }
-    runChunk<T>(row_.varying, storage, ChunkSize, m);
-    std::copy_n(storage + output.slot * ChunkSize, m, out + start);
+    runChunk<T>(row_.varying, rowSlots_.data(), m);
+    std::copy_n(rowSlots_[output.slot], m, out + start);
   }
 }
 

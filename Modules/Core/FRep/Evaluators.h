@@ -56,10 +56,25 @@ private:
 
   TapePtr tape_;
   std::vector<double> parameters_;
+  // The x coordinates currently held by the row program's x slot.
+  struct RowX
+  {
+    double x0, dx;
+    std::int64_t first;
+    std::size_t count;
+    bool operator==(const RowX& o) const
+    {
+      return x0 == o.x0 && dx == o.dx && first == o.first && count == o.count;
+    }
+  };
+
   std::vector<T> storage_;    // eval(): slotCount chunks
+  std::vector<T*> slots_;     // eval(): where each slot's values are
   RowProgram row_;            // evalRowX(): the tape split along x
   std::vector<T> rowStorage_; // evalRowX(): chunkSlotCount chunks
+  std::vector<T*> rowSlots_;  // evalRowX(): where each chunk slot's values are
   std::vector<T> scalars_;    // evalRowX(): one value per value id
+  RowX rowX_{ 0, 0, -1, 0 };
 };
 
 /// Interval arithmetic over a region, with the choices needed to simplify the tape there.

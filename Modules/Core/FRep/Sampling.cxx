@@ -173,7 +173,7 @@ void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& 
     const std::int64_t i1 = std::min(dims[0], i0 + brick[0]), j1 = std::min(dims[1], j0 + brick[1]),
                        k1 = std::min(dims[2], k0 + brick[2]);
     BatchEvaluator<T>* evaluator = &ws.full;
-    if (options.prune)
+    if (options.prune && tape->choiceCount() > 0)
     {
       Region region;
       region.axes[0] = { grid.origin[0] + i0 * grid.spacing[0], grid.origin[0] + (i1 - 1) * grid.spacing[0] };

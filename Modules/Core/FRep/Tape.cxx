@@ -183,6 +183,10 @@ TapePtr Tape::build(std::uint32_t parameterCount, std::vector<double> constants,
     const TapeSsa& s = tape->ssa_[i];
     const auto result = static_cast<std::uint32_t>(leafCount + i);
     ops.push_back({ s.op, result, { s.a, s.b, s.c } });
+    if (s.op == Opcode::Min || s.op == Opcode::Max || s.op == Opcode::Select)
+    {
+      ++tape->choiceCount_;
+    }
     for (int k = 0; k < opcodeArity(s.op); ++k)
     {
       axes[result] |= axes[ops.back().operand[k]];
@@ -340,7 +344,7 @@ RowProgram Tape::rowProgram(std::uint8_t varyingAxes) const
       if (!varies(v) && slotOfValue[v] == std::numeric_limits<std::uint32_t>::max())
       {
         slotOfValue[v] = next;
-        p.broadcasts.push_back({ v, next++ });
+        (axes_[v] ? p.broadcasts : p.fixedBroadcasts).push_back({ v, next++ });
       }
     }
   }

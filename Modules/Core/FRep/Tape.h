@@ -38,6 +38,8 @@ struct RowProgram
   std::uint32_t scalarSlotCount = 0;
   /// (scalar slot, chunk slot): uniform values that per-point code reads, copied once per row.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> broadcasts;
+  /// The same for values that depend on no coordinate (constants, parameters): copied once.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> fixedBroadcasts;
   /// Per-point code over chunk slots.
   std::vector<Instruction> varying;
   std::uint32_t chunkSlotCount = 0;
@@ -81,6 +83,8 @@ public:
   const std::vector<std::uint32_t>& outputs() const { return outputs_; }
   /// Bit i set when some output depends on Axis(i).
   std::uint8_t axesUsed() const { return axesUsed_; }
+  /// Number of min, max and select instructions: what interval pruning can cut.
+  std::size_t choiceCount() const { return choiceCount_; }
 
   /// A shorter tape that gives identical results wherever `choices` hold (one entry per
   /// instruction, as filled by IntervalEvaluator). Returns this tape's twin when nothing is cut.
@@ -106,6 +110,7 @@ private:
   std::vector<std::uint32_t> outputs_;
   std::uint32_t slotCount_ = 0;
   std::uint8_t axesUsed_ = 0;
+  std::size_t choiceCount_ = 0;
 };
 
 using TapePtr = std::shared_ptr<const Tape>;
