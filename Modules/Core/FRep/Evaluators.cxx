@@ -551,10 +551,11 @@ Interval intervalOp(Opcode op, const Interval& a, const Interval& b, const Inter
       return { -inf, inf, true }; // 0/0 possible
     case Opcode::Pow:
     {
-      if (a.lo > 0 && std::isfinite(a.hi) && std::isfinite(b.lo) && std::isfinite(b.hi))
+      if ((a.lo > 0 || (a.lo >= 0 && b.lo > 0)) && std::isfinite(a.hi) && std::isfinite(b.lo) &&
+        std::isfinite(b.hi))
       {
         // a^b = exp(b ln a) is monotone in b ln a, which is bilinear in (b, ln a): extremes at
-        // the corners.
+        // the corners (with 0^b = 0 for b > 0, the limit of that form).
         const double p[4] = { std::pow(a.lo, b.lo), std::pow(a.lo, b.hi), std::pow(a.hi, b.lo),
           std::pow(a.hi, b.hi) };
         return widen({ *std::min_element(p, p + 4), *std::max_element(p, p + 4), nanIn });

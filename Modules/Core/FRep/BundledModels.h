@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// The CSG recipes behind the bundled models `csg3` and `random1000`. They are exposed so that the
+// benchmark can build the very same trees out of VTK implicit functions (vtkSphere, vtkBox,
+// vtkCylinder, vtkImplicitBoolean) and compare fields and speed apples to apples.
+
+#include "FRep/Expr.h"
+#include "FRep/ModelRegistry.h"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace ictk::frep::bundled
+{
+
+/// One node of a CSG tree. Leaves use `p`; operations use the children `a` and `b` (indices into
+/// CsgRecipe::nodes).
+struct CsgNode
+{
+  enum class Kind : std::uint8_t
+  {
+    Sphere,       ///< p = (cx, cy, cz, r)
+    Box,          ///< p = (xmin, ymin, zmin, xmax, ymax, zmax), every side > 0
+    CylinderY,    ///< infinite, along y: p = (cx, cy, cz, r)
+    Union,        ///< VTK: min; ICTK: max
+    Intersection, ///< VTK: max; ICTK: min
+    Difference    ///< a \ b. VTK: max(a, -b); ICTK: min(a, -b)
+  };
+  Kind kind = Kind::Sphere;
+  std::array<double, 6> p{};
+  int a = -1;
+  int b = -1;
+};
+
+struct CsgRecipe
+{
+  std::vector<CsgNode> nodes;
+  int root = -1;
+};
+
+/// (sphere r = 1 ∩ box [-0.8, 0.8]^3) \ cylinder along y, r = 0.4, all centred at the origin.
+CsgRecipe csg3Recipe();
+/// The unit sphere at the origin (the `sphere` model), as a one-node recipe.
+CsgRecipe sphereRecipe();
+/// The random CSG of spheres and boxes behind `random1000` (fixed seed, portable).
+CsgRecipe random1000Recipe();
+
+/// The ICTK field (f >= 0 inside) of a recipe: exactly minus the field of the equivalent
+/// vtkImplicitBoolean tree, operation for operation (up to the rounding of vtkCylinder's
+/// projection on its axis).
+Expr csgField(const CsgRecipe& recipe);
+
+/// Minus vtkBox::EvaluateFunction for the box [lo, hi]: -max_i d_i inside and -|distance| outside,
+/// d_i = max(lo_i - p_i, p_i - hi_i). Every side must be longer than 0.
+Expr vtkBoxField(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
+
+/// Every bundled model (registerBundledModels() registers these).
+std::vector<ModelInfo> modelInfos();
+
+} // namespace ictk::frep::bundled
