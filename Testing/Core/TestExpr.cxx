@@ -68,3 +68,18 @@ TEST(Expr, DeepChainsDoNotOverflowTheStack)
   }
   EXPECT_GT(f.nodeCount(), 200000u);
 }
+
+TEST(Expr, SubtreeReplacement)
+{
+  // Replace the sphere in max(sphere, box) by a smaller one: the box part is shared, not rebuilt.
+  const Expr x = Expr::x(), y = Expr::y();
+  const Expr sphere = Expr(1.0) - square(x) - square(y);
+  const Expr box = min(Expr(0.5) - abs(x), Expr(0.5) - abs(y));
+  const Expr model = max(sphere, box);
+  const Expr smaller = Expr(0.25) - square(x) - square(y);
+  const Expr edited = model.replace(sphere, smaller);
+  EXPECT_TRUE(edited.child(1).identical(box));
+  EXPECT_DOUBLE_EQ(evaluateReference(model, { 0.8, 0, 0, 0 }), 0.36);
+  EXPECT_DOUBLE_EQ(evaluateReference(edited, { 0.8, 0, 0, 0 }), -0.3); // box wins: 0.5 - 0.8
+  EXPECT_TRUE(model.replace(Expr::z(), x).identical(model)); // nothing to replace
+}

@@ -3,6 +3,8 @@
 
 #include "FRep/Kernels.h"
 
+#include <functional>
+
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -299,32 +301,54 @@ std::size_t Expr::nodeCount() const
   return n;
 }
 
-Expr Expr::substitute(const std::array<Expr, AxisCount>& map) const
+namespace
+{
+// Rebuilds `root` bottom-up; `leaf` gives the replacement of a node (or null to rebuild it from its
+// rewritten children).
+Expr rewrite(const Expr& root, const std::function<const Expr*(const Expr&)>& leaf)
 {
   std::unordered_map<const Node*, Expr> rewritten;
-  visitPostOrder(
+  root.visitPostOrder(
     [&](const Expr& e)
     {
       Expr r;
+      if (const Expr* replacement = leaf(e))
+      {
+        rewritten.emplace(e.id(), *replacement);
+        return;
+      }
       switch (e.arity())
       {
         case 0:
-          r = e.opcode() == Opcode::Variable ? map[static_cast<int>(e.axis())] : e;
+          r = e;
           break;
         case 1:
-          r = make(e.opcode(), rewritten.at(e.child(0).id()));
+          r = Expr::make(e.opcode(), rewritten.at(e.child(0).id()));
           break;
         case 2:
-          r = make(e.opcode(), rewritten.at(e.child(0).id()), rewritten.at(e.child(1).id()));
+          r = Expr::make(e.opcode(), rewritten.at(e.child(0).id()), rewritten.at(e.child(1).id()));
           break;
         default:
-          r = make(e.opcode(), rewritten.at(e.child(0).id()), rewritten.at(e.child(1).id()),
+          r = Expr::make(e.opcode(), rewritten.at(e.child(0).id()), rewritten.at(e.child(1).id()),
             rewritten.at(e.child(2).id()));
           break;
       }
       rewritten.emplace(e.id(), std::move(r));
     });
-  return rewritten.at(id());
+  return rewritten.at(root.id());
+}
+} // namespace
+
+Expr Expr::substitute(const std::array<Expr, AxisCount>& map) const
+{
+  return rewrite(*this,
+    [&](const Expr& e) -> const Expr*
+    { return e.opcode() == Opcode::Variable ? &map[static_cast<int>(e.axis())] : nullptr; });
+}
+
+Expr Expr::replace(const Expr& from, const Expr& to) const
+{
+  return rewrite(*this, [&](const Expr& e) -> const Expr* { return e.identical(from) ? &to : nullptr; });
 }
 
 

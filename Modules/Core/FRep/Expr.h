@@ -114,6 +114,10 @@ public:
   /// sub-trees are rewritten once.
   Expr substitute(const std::array<Expr, AxisCount>& map) const;
 
+  /// Replaces every occurrence of the sub-tree `from` by `to` (thesis L2198, L2208-L2213: subtree
+  /// replacement). The original expression is unchanged; shared parts are reused.
+  Expr replace(const Expr& from, const Expr& to) const;
+
   /// Visits every distinct node once, children before parents.
   void visitPostOrder(const std::function<void(const Expr&)>& visit) const;
 
