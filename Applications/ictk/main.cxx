@@ -1,0 +1,815 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// ictk: the command-line face of ICTK.
+//
+//   ictk models                         list the registered models
+//   ictk eval MODEL --at x,y,z[,t]      value (and with --json gradient, normal, membership,
+//                                       attributes) at a point
+//   ictk sample MODEL -o out.vti        sample on a grid (.vti), optionally extract the surface
+//
+// Every user error ends in one line "ictk: error: ..." on stderr and exit code 2; nothing is
+// left half-written (outputs go to a temporary file in the target folder, renamed on success).
+
+#include "FRep/Evaluators.h"
+#include "FRep/Hypervolume.h"
+#include "FRep/ModelRegistry.h"
+#include "FRep/Sampling.h"
+
+#include "ictkFRepSampler.h"
+
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
+#include <vtkDataObject.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkOutputWindow.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkSMPTools.h>
+#include <vtkSmartPointer.h>
+#include <vtkXMLImageDataWriter.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace frep = ictk::frep;
+namespace fs = std::filesystem;
+
+namespace
+{
+
+/// A user error: reported as one line, exit code 2.
+class UserError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+constexpr int ExitUserError = 2;
+constexpr int ExitInterrupted = 130;
+
+// --- parsing ------------------------------------------------------------------------------------
+
+std::string Trim(const std::string& s)
+{
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos)
+  {
+    return {};
+  }
+  const auto e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> SplitCommas(const std::string& text)
+{
+  std::vector<std::string> fields;
+  std::string::size_type start = 0;
+  while (true)
+  {
+    const auto comma = text.find(',', start);
+    fields.push_back(Trim(text.substr(start, comma == std::string::npos ? comma : comma - start)));
+    if (comma == std::string::npos)
+    {
+      return fields;
+    }
+    start = comma + 1;
+  }
+}
+
+/// Parses a comma-separated list of finite numbers. `names` names the fields for messages (e.g.
+/// x, y, z); fields beyond it are called "value N".
+std::vector<double> ParseNumbers(const std::string& text, const std::string& option,
+  const std::vector<std::string>& names, std::size_t minCount, std::size_t maxCount,
+  const std::string& expected)
+{
+  const std::vector<std::string> fields = SplitCommas(text);
+  if (fields.size() < minCount || fields.size() > maxCount)
+  {
+    throw UserError(option + ": expected " + expected + ", got " + std::to_string(fields.size()) +
+      " value(s) in '" + text + "'");
+  }
+  std::vector<double> values;
+  for (std::size_t i = 0; i < fields.size(); ++i)
+  {
+    const std::string name =
+      i < names.size() ? "field '" + names[i] + "'" : "value " + std::to_string(i + 1);
+    const std::string& field = fields[i];
+    if (field.empty())
+    {
+      throw UserError(option + ": " + name + " is empty in '" + text + "'");
+    }
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(field.c_str(), &end);
+    if (end == field.c_str() || *end != '\0')
+    {
+      throw UserError(option + ": " + name + " is not a number: '" + field + "'");
+    }
+    if (!std::isfinite(v) || errno == ERANGE)
+    {
+      throw UserError(option + ": " + name + " must be a finite number, got '" + field + "'");
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+std::vector<double> ParseParameters(const std::string& text)
+{
+  if (text.empty())
+  {
+    return {};
+  }
+  return ParseNumbers(text, "--params", {}, 1, 1024, "p1,p2,...");
+}
+
+std::array<std::int64_t, 3> ParseDims(const std::string& text)
+{
+  static const std::vector<std::string> names{ "NX", "NY", "NZ" };
+  const std::vector<std::string> fields = SplitCommas(text);
+  if (fields.size() != 3)
+  {
+    throw UserError("--dims: expected NX,NY,NZ, got " + std::to_string(fields.size()) +
+      " value(s) in '" + text + "'");
+  }
+  std::array<std::int64_t, 3> dims{};
+  for (int a = 0; a < 3; ++a)
+  {
+    errno = 0;
+    char* end = nullptr;
+    const long long v = std::strtoll(fields[a].c_str(), &end, 10);
+    if (fields[a].empty() || end == fields[a].c_str() || *end != '\0' || errno == ERANGE)
+    {
+      throw UserError("--dims: field '" + names[a] + "' is not an integer: '" + fields[a] + "'");
+    }
+    dims[a] = v;
+  }
+  return dims;
+}
+
+const frep::ModelInfo& FindModel(const std::string& name)
+{
+  frep::registerBundledModels();
+  try
+  {
+    return frep::findModel(name);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(e.what());
+  }
+}
+
+std::string FormatBounds(const std::array<double, 3>& lo, const std::array<double, 3>& hi)
+{
+  std::ostringstream os;
+  os << "[" << lo[0] << "," << hi[0] << "]x[" << lo[1] << "," << hi[1] << "]x[" << lo[2] << ","
+     << hi[2] << "]";
+  return os.str();
+}
+
+// --- VTK messages
+// ---------------------------------------------------------------------------------
+
+/// Collects VTK's error and warning texts instead of printing them, so that a failure becomes one
+/// "ictk: error:" line rather than VTK's multi-line reports (and the executive's follow-ups).
+class ictkCaptureOutputWindow : public vtkOutputWindow
+{
+public:
+  static ictkCaptureOutputWindow* New();
+  vtkTypeMacro(ictkCaptureOutputWindow, vtkOutputWindow);
+
+  void DisplayErrorText(const char* text) override { this->Errors.push_back(Message(text)); }
+  void DisplayWarningText(const char* text) override { this->Warnings.push_back(Message(text)); }
+  void DisplayGenericWarningText(const char* text) override
+  {
+    this->Warnings.push_back(Message(text));
+  }
+  void DisplayText(const char*) override {}
+
+  std::vector<std::string> Errors;
+  std::vector<std::string> Warnings;
+
+private:
+  /// "ERROR: In file, line N\nClass (0x...): message\n\n" -> "message".
+  static std::string Message(const char* text)
+  {
+    std::string s = text ? text : "";
+    const auto header = s.find('\n');
+    if (s.rfind("ERROR: In ", 0) == 0 || s.rfind("Warning: In ", 0) == 0)
+    {
+      s = header == std::string::npos ? s : s.substr(header + 1);
+    }
+    const auto object = s.find("): ");
+    if (object != std::string::npos && s.find(" (") < object)
+    {
+      s = s.substr(object + 3);
+    }
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' '))
+    {
+      s.pop_back();
+    }
+    return s;
+  }
+};
+vtkStandardNewMacro(ictkCaptureOutputWindow);
+
+ictkCaptureOutputWindow* CaptureVtkMessages()
+{
+  static vtkSmartPointer<ictkCaptureOutputWindow> window;
+  if (!window)
+  {
+    window = vtkSmartPointer<ictkCaptureOutputWindow>::New();
+    vtkOutputWindow::SetInstance(window);
+  }
+  return window;
+}
+
+/// Throws the first VTK error recorded since `before`, prefixed by `what`.
+void ThrowIfVtkFailed(
+  const ictkCaptureOutputWindow* window, std::size_t before, const std::string& what)
+{
+  if (window->Errors.size() > before)
+  {
+    throw UserError(what + ": " + window->Errors[before]);
+  }
+}
+
+// --- output files
+// ---------------------------------------------------------------------------------
+
+/// A temporary file next to the destination, renamed onto it by Commit() and removed otherwise.
+class AtomicOutput
+{
+public:
+  explicit AtomicOutput(const std::string& destination)
+    : Destination(destination)
+  {
+    if (destination.empty())
+    {
+      throw UserError("the output path is empty");
+    }
+    const fs::path path(destination);
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+    {
+      throw UserError("cannot write '" + destination + "': it is a directory");
+    }
+    const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    if (!fs::is_directory(folder, ec))
+    {
+      throw UserError(
+        "cannot write '" + destination + "': folder '" + folder.string() + "' does not exist");
+    }
+    std::string pattern = (folder / ("." + path.filename().string() + ".tmp-XXXXXX")).string();
+    const int fd = mkstemp(pattern.data());
+    if (fd < 0)
+    {
+      throw UserError("cannot write '" + destination + "': " + std::strerror(errno));
+    }
+    // mkstemp creates the file 0600; give the result the permissions a plain create would.
+    const mode_t mask = umask(0);
+    umask(mask);
+    fchmod(fd, 0666 & ~mask);
+    close(fd);
+    this->Temporary = pattern;
+  }
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+  ~AtomicOutput()
+  {
+    if (!this->Temporary.empty())
+    {
+      std::remove(this->Temporary.c_str());
+    }
+  }
+
+  const std::string& Path() const { return this->Temporary; }
+
+  void Commit()
+  {
+    if (std::rename(this->Temporary.c_str(), this->Destination.c_str()) != 0)
+    {
+      throw UserError("cannot write '" + this->Destination + "': " + std::strerror(errno));
+    }
+    this->Temporary.clear();
+  }
+
+private:
+  std::string Destination;
+  std::string Temporary;
+};
+
+// --- progress
+// -------------------------------------------------------------------------------------
+
+std::atomic<bool> Interrupted{ false };
+
+extern "C" void OnInterrupt(int)
+{
+  Interrupted = true;
+}
+
+/// A progress bar on a terminal, a few percentage lines otherwise (logs stay readable).
+struct ProgressReporter
+{
+  std::string Label;
+  bool Terminal = isatty(STDERR_FILENO) != 0;
+  int LastShown = -1;
+  bool Finished = false;
+
+  void Show(double fraction)
+  {
+    const int percent = static_cast<int>(std::floor(std::min(1.0, std::max(0.0, fraction)) * 100));
+    if (this->Finished || percent == this->LastShown)
+    {
+      return;
+    }
+    if (this->Terminal)
+    {
+      constexpr int Width = 40;
+      const int filled = percent * Width / 100;
+      std::cerr << "\r" << this->Label << " [" << std::string(filled, '#')
+                << std::string(Width - filled, ' ') << "] " << std::setw(3) << percent << "%"
+                << std::flush;
+      if (percent == 100)
+      {
+        std::cerr << "\n";
+        this->Finished = true;
+      }
+    }
+    else if (percent / 25 != this->LastShown / 25 || this->LastShown < 0)
+    {
+      std::cerr << this->Label << ": " << percent << "%\n";
+      this->Finished = percent == 100;
+    }
+    this->LastShown = percent;
+  }
+
+  void End()
+  {
+    if (this->Terminal && !this->Finished && this->LastShown >= 0)
+    {
+      std::cerr << "\n";
+    }
+    this->Finished = true;
+  }
+};
+
+void OnProgress(vtkObject* caller, unsigned long, void* clientData, void* callData)
+{
+  auto* reporter = static_cast<ProgressReporter*>(clientData);
+  reporter->Show(*static_cast<double*>(callData));
+  if (Interrupted)
+  {
+    static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1);
+  }
+}
+
+double Seconds(std::chrono::steady_clock::time_point since)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// --- commands
+// -------------------------------------------------------------------------------------
+
+int RunModels(bool json)
+{
+  frep::registerBundledModels();
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  std::size_t width = 4;
+  for (const std::string& name : frep::modelNames())
+  {
+    width = std::max(width, name.size());
+  }
+  for (const std::string& name : frep::modelNames())
+  {
+    const frep::ModelInfo& info = frep::findModel(name);
+    if (json)
+    {
+      list.push_back({ { "name", info.name }, { "description", info.description },
+        { "bounds",
+          { info.boundsLo[0], info.boundsHi[0], info.boundsLo[1], info.boundsHi[1],
+            info.boundsLo[2], info.boundsHi[2] } } });
+    }
+    else
+    {
+      std::cout << std::left << std::setw(static_cast<int>(width)) << info.name << "  "
+                << FormatBounds(info.boundsLo, info.boundsHi) << "\n"
+                << std::string(width + 2, ' ') << info.description << "\n";
+    }
+  }
+  if (json)
+  {
+    std::cout << list.dump(2) << "\n";
+  }
+  return 0;
+}
+
+struct EvalOptions
+{
+  std::string Model;
+  std::string At;
+  std::string Params;
+  bool Json = false;
+};
+
+int RunEval(const EvalOptions& o)
+{
+  const frep::ModelInfo& info = FindModel(o.Model);
+  const std::vector<double> at =
+    ParseNumbers(o.At, "--at", { "x", "y", "z", "t" }, 3, 4, "x,y,z or x,y,z,t");
+  const std::array<double, 4> p{ at[0], at[1], at[2], at.size() > 3 ? at[3] : 0.0 };
+  const std::vector<double> params = ParseParameters(o.Params);
+
+  const frep::Hypervolume hv = info.build();
+  std::vector<double> attributes(hv.attributeComponentCount());
+  double value = 0;
+  std::unique_ptr<frep::HypervolumeEvaluator> evaluator;
+  try
+  {
+    evaluator = std::make_unique<frep::HypervolumeEvaluator>(hv, params);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(std::string("--params: ") + e.what());
+  }
+  evaluator->eval(p, value, attributes.data());
+  if (!o.Json)
+  {
+    std::cout << std::setprecision(17) << value << "\n";
+    return 0;
+  }
+
+  frep::GradientEvaluator gradient(frep::Tape::compile(hv.geometry().function()), params);
+  const frep::ValueGradient vg = gradient.eval(p[0], p[1], p[2], p[3]);
+  const std::array<double, 3> normal = frep::outwardNormal(vg);
+
+  nlohmann::ordered_json out;
+  out["model"] = info.name;
+  out["point"] = p;
+  out["value"] = value;
+  out["gradient"] = vg.gradient;
+  out["normal"] = normal;
+  out["membership"] = evaluator->membership(p);
+  nlohmann::ordered_json attributeValues = nlohmann::ordered_json::object();
+  std::size_t k = 0;
+  for (const frep::Attribute& a : hv.attributes())
+  {
+    if (a.components.size() == 1)
+    {
+      attributeValues[a.name] = attributes[k++];
+    }
+    else
+    {
+      nlohmann::ordered_json values = nlohmann::ordered_json::array();
+      for (std::size_t c = 0; c < a.components.size(); ++c)
+      {
+        values.push_back(attributes[k++]);
+      }
+      attributeValues[a.name] = values;
+    }
+  }
+  out["attributes"] = attributeValues;
+  // NaN and infinities have no JSON spelling: nlohmann writes them as null.
+  std::cout << out.dump(2) << "\n";
+  return 0;
+}
+
+struct SampleCommandOptions
+{
+  std::string Model;
+  std::string Output;
+  std::int64_t Resolution = 64;
+  std::string Dims;
+  std::string Bounds;
+  double Time = 0;
+  int Threads = 0;
+  bool Double = false;
+  std::string Surface;
+  std::string Params;
+};
+
+int RunSample(const SampleCommandOptions& o)
+{
+  const frep::ModelInfo& info = FindModel(o.Model);
+  const std::vector<double> params = ParseParameters(o.Params);
+  if (!std::isfinite(o.Time))
+  {
+    throw UserError("--time must be a finite number");
+  }
+  if (o.Threads < 0)
+  {
+    throw UserError("--threads must be 0 (automatic) or more, got " + std::to_string(o.Threads));
+  }
+
+  std::array<double, 3> lo = info.boundsLo, hi = info.boundsHi;
+  if (!o.Bounds.empty())
+  {
+    const std::vector<double> b = ParseNumbers(
+      o.Bounds, "--bounds", { "x0", "x1", "y0", "y1", "z0", "z1" }, 6, 6, "x0,x1,y0,y1,z0,z1");
+    static const char* axes[] = { "x", "y", "z" };
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = b[2 * a];
+      hi[a] = b[2 * a + 1];
+      if (lo[a] > hi[a])
+      {
+        std::ostringstream os;
+        os << "--bounds: " << axes[a] << "0 > " << axes[a] << "1 (" << lo[a] << " > " << hi[a]
+           << ")";
+        throw UserError(os.str());
+      }
+    }
+  }
+
+  std::array<std::int64_t, 3> dims;
+  if (!o.Dims.empty())
+  {
+    dims = ParseDims(o.Dims);
+    static const char* names[] = { "NX", "NY", "NZ" };
+    for (int a = 0; a < 3; ++a)
+    {
+      if (dims[a] < 1)
+      {
+        throw UserError(std::string("--dims: ") + names[a] + " must be at least 1, got " +
+          std::to_string(dims[a]));
+      }
+    }
+  }
+  else
+  {
+    if (o.Resolution < 2)
+    {
+      throw UserError("--resolution must be at least 2, got " + std::to_string(o.Resolution));
+    }
+    dims = { o.Resolution, o.Resolution, o.Resolution };
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    // A flat axis of the box (a 2D model) is sampled once, as ictkFRepSampler does.
+    if (!(hi[a] > lo[a]))
+    {
+      dims[a] = 1;
+    }
+  }
+
+  const frep::Hypervolume hv = info.build();
+  std::size_t values = 1 + hv.attributeComponentCount();
+  for (const frep::Attribute& a : hv.attributes())
+  {
+    if (a.components.size() > 1)
+    {
+      ++values; // the sampler's scratch component
+      break;
+    }
+  }
+  const std::size_t bytesPerPoint = values * (o.Double ? sizeof(double) : sizeof(float));
+  const frep::Grid grid = frep::gridOverBox(lo, hi, dims, o.Time);
+  try
+  {
+    frep::checkGrid(grid, bytesPerPoint);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(std::string("cannot sample: ") + e.what());
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    // VTK extents are int.
+    if (dims[a] > INT_MAX)
+    {
+      throw UserError("cannot sample: " + std::to_string(dims[a]) +
+        " points along one axis is more than VTK's limit of " + std::to_string(INT_MAX));
+    }
+  }
+
+  // Fail on an unwritable destination before spending time on sampling.
+  AtomicOutput volumeFile(o.Output);
+  std::unique_ptr<AtomicOutput> surfaceFile;
+  if (!o.Surface.empty())
+  {
+    surfaceFile = std::make_unique<AtomicOutput>(o.Surface);
+  }
+
+  ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+  if (o.Threads > 0)
+  {
+    vtkSMPTools::Initialize(o.Threads);
+  }
+
+  vtkNew<ictkFRepSampler> sampler;
+  sampler->SetHypervolume(hv);
+  sampler->SetParameters(params);
+  sampler->SetModelBounds(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+  sampler->SetSampleDimensions(
+    static_cast<int>(dims[0]), static_cast<int>(dims[1]), static_cast<int>(dims[2]));
+  sampler->SetTime(o.Time);
+  sampler->SetNumberOfThreads(o.Threads);
+  sampler->SetOutputScalarType(o.Double ? VTK_DOUBLE : VTK_FLOAT);
+
+  ProgressReporter progress;
+  progress.Label = "sampling " + info.name;
+  vtkNew<vtkCallbackCommand> onProgress;
+  onProgress->SetCallback(OnProgress);
+  onProgress->SetClientData(&progress);
+  sampler->AddObserver(vtkCommand::ProgressEvent, onProgress);
+
+  std::signal(SIGINT, OnInterrupt);
+  std::signal(SIGTERM, OnInterrupt);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::size_t errorsBefore = messages->Errors.size();
+  sampler->Update();
+  progress.End();
+  if (Interrupted)
+  {
+    std::cerr << "ictk: interrupted; nothing written\n";
+    return ExitInterrupted;
+  }
+  ThrowIfVtkFailed(messages, errorsBefore, "sampling failed");
+  vtkImageData* image = sampler->GetOutput();
+  if (image->GetNumberOfPoints() != grid.pointCount())
+  {
+    throw UserError("sampling failed: the output has " +
+      std::to_string(image->GetNumberOfPoints()) + " points instead of " +
+      std::to_string(grid.pointCount()));
+  }
+  const double sampleSeconds = Seconds(t0);
+
+  const auto t1 = std::chrono::steady_clock::now();
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  writer->SetFileName(volumeFile.Path().c_str());
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  errorsBefore = messages->Errors.size();
+  if (writer->Write() != 1 || writer->GetErrorCode() != 0)
+  {
+    ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
+    throw UserError("cannot write '" + o.Output + "'");
+  }
+  ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
+  volumeFile.Commit();
+  const double writeSeconds = Seconds(t1);
+
+  std::cout << "wrote " << o.Output << " (" << dims[0] << " x " << dims[1] << " x " << dims[2]
+            << " points; arrays:";
+  vtkPointData* pd = image->GetPointData();
+  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+  {
+    std::cout << (i ? ", " : " ") << pd->GetArrayName(i);
+  }
+  std::cout << ") in " << std::fixed << std::setprecision(3) << sampleSeconds + writeSeconds
+            << " s (sampling " << sampleSeconds << " s, writing " << writeSeconds << " s)\n";
+
+  if (surfaceFile)
+  {
+    const auto t2 = std::chrono::steady_clock::now();
+    vtkNew<vtkFlyingEdges3D> contour;
+    contour->SetInputData(image);
+    contour->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "f");
+    contour->SetValue(0, 0.0);
+    // f grows inwards, so the negated gradient Flying Edges uses for normals points outwards.
+    contour->ComputeNormalsOn();
+    contour->ComputeScalarsOff();
+    contour->InterpolateAttributesOn();
+    errorsBefore = messages->Errors.size();
+    contour->Update();
+    ThrowIfVtkFailed(messages, errorsBefore, "surface extraction failed");
+    vtkPolyData* surface = contour->GetOutput();
+
+    vtkNew<vtkXMLPolyDataWriter> surfaceWriter;
+    surfaceWriter->SetInputData(surface);
+    surfaceWriter->SetFileName(surfaceFile->Path().c_str());
+    surfaceWriter->SetDataModeToAppended();
+    surfaceWriter->EncodeAppendedDataOff();
+    if (surfaceWriter->Write() != 1 || surfaceWriter->GetErrorCode() != 0)
+    {
+      ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Surface + "'");
+      throw UserError("cannot write '" + o.Surface + "'");
+    }
+    ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Surface + "'");
+    surfaceFile->Commit();
+    std::cout << "wrote " << o.Surface << " (" << surface->GetNumberOfPoints() << " points, "
+              << surface->GetNumberOfPolys() << " triangles) in " << Seconds(t2) << " s\n";
+  }
+  return 0;
+}
+
+int Run(int argc, char** argv)
+{
+  CLI::App app{ "ICTK: Implicit Complex ToolKit command-line tool", "ictk" };
+  app.set_version_flag("--version", "ictk 0.1.0");
+  app.require_subcommand(1);
+
+  bool modelsJson = false;
+  CLI::App* models =
+    app.add_subcommand("models", "List the registered models (name, bounds, description)");
+  models->add_flag("--json", modelsJson, "Print a JSON array");
+
+  EvalOptions evalOptions;
+  CLI::App* eval = app.add_subcommand("eval", "Evaluate a model at a point");
+  eval->add_option("model", evalOptions.Model, "Model name (see `ictk models`)")->required();
+  eval->add_option("--at", evalOptions.At, "The point: x,y,z or x,y,z,t")->required();
+  eval->add_option("--params", evalOptions.Params, "Model parameters: p1,p2,...");
+  eval->add_flag("--json", evalOptions.Json,
+    "Print a JSON object with value, gradient, normal, membership and attributes");
+
+  SampleCommandOptions sampleOptions;
+  CLI::App* sample = app.add_subcommand("sample", "Sample a model on a regular grid (.vti)");
+  sample->add_option("model", sampleOptions.Model, "Model name (see `ictk models`)")->required();
+  sample->add_option("-o,--output", sampleOptions.Output, "Output image (.vti)")->required();
+  CLI::Option* resolution =
+    sample->add_option("--resolution", sampleOptions.Resolution, "Points per axis (default 64)");
+  CLI::Option* dims = sample->add_option("--dims", sampleOptions.Dims, "Points per axis: NX,NY,NZ");
+  resolution->excludes(dims);
+  sample->add_option("--bounds", sampleOptions.Bounds,
+    "Sampled box x0,x1,y0,y1,z0,z1 (default: the model's bounds)");
+  sample->add_option("--time", sampleOptions.Time, "Time t (default 0)");
+  sample->add_option("--threads", sampleOptions.Threads, "Threads (default: all cores)");
+  sample->add_flag(
+    "--double", sampleOptions.Double, "Write double-precision arrays (default float)");
+  sample->add_option("--surface", sampleOptions.Surface,
+    "Also extract the surface f = 0 (Flying Edges) into this .vtp");
+  sample->add_option("--params", sampleOptions.Params, "Model parameters: p1,p2,...");
+
+  try
+  {
+    app.parse(argc, argv);
+  }
+  catch (const CLI::CallForHelp& e)
+  {
+    return app.exit(e);
+  }
+  catch (const CLI::CallForAllHelp& e)
+  {
+    return app.exit(e);
+  }
+  catch (const CLI::CallForVersion& e)
+  {
+    return app.exit(e);
+  }
+  catch (const CLI::ParseError& e)
+  {
+    throw UserError(std::string(e.what()) + " (see ictk --help)");
+  }
+
+  if (*models)
+  {
+    return RunModels(modelsJson);
+  }
+  if (*eval)
+  {
+    return RunEval(evalOptions);
+  }
+  return RunSample(sampleOptions);
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+  try
+  {
+    return Run(argc, argv);
+  }
+  catch (const std::bad_alloc&)
+  {
+    std::cerr << "ictk: error: out of memory\n";
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "ictk: error: " << e.what() << "\n";
+  }
+  catch (...)
+  {
+    std::cerr << "ictk: error: unexpected failure\n";
+  }
+  return ExitUserError;
+}

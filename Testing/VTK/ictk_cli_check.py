@@ -1,0 +1,208 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""Runs the ictk command-line tool as a user would and checks what it prints and writes.
+
+Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
+  models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d
+  expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
+"@WORK@" in ICTK-ARGS is replaced by the work folder.
+"""
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+
+def run(ictk, args, check=True):
+    p = subprocess.run([ictk] + args, capture_output=True, text=True, timeout=100)
+    if check and p.returncode != 0:
+        sys.exit(f"FAIL: ictk {' '.join(args)} exited {p.returncode}\nstdout:\n{p.stdout}\nstderr:\n{p.stderr}")
+    return p
+
+
+def near(a, b, tol, what):
+    if not (abs(a - b) <= tol):
+        sys.exit(f"FAIL: {what}: {a} != {b} (tolerance {tol})")
+
+
+def check_models(ictk, work):
+    out = run(ictk, ["models"]).stdout
+    for name in ("sphere", "walnut"):
+        if not re.search(rf"^{name}\s+\[", out, re.M):
+            sys.exit(f"FAIL: 'ictk models' does not list {name}:\n{out}")
+    models = json.loads(run(ictk, ["models", "--json"]).stdout)
+    sphere = [m for m in models if m["name"] == "sphere"]
+    if len(sphere) != 1 or len(sphere[0]["bounds"]) != 6 or not sphere[0]["description"]:
+        sys.exit(f"FAIL: 'ictk models --json' has no proper sphere entry: {models}")
+
+
+def check_eval_json(ictk, work):
+    # The bundled sphere is f = 1 - x^2 - y^2 - z^2.
+    x, y, z = 0.3, 0.4, 0.5
+    r = json.loads(run(ictk, ["eval", "sphere", "--at", f"{x},{y},{z}", "--json"]).stdout)
+    if r["model"] != "sphere" or r["point"] != [x, y, z, 0.0]:
+        sys.exit(f"FAIL: model/point wrong: {r}")
+    near(r["value"], 1 - x * x - y * y - z * z, 1e-12, "value")
+    for got, want in zip(r["gradient"], [-2 * x, -2 * y, -2 * z, 0.0]):
+        near(got, want, 1e-12, "gradient")
+    # A finite difference agrees with the reported gradient.
+    h = 1e-5
+    plus = json.loads(run(ictk, ["eval", "sphere", "--at", f"{x + h},{y},{z}", "--json"]).stdout)["value"]
+    minus = json.loads(run(ictk, ["eval", "sphere", "--at", f"{x - h},{y},{z}", "--json"]).stdout)["value"]
+    near((plus - minus) / (2 * h), r["gradient"][0], 1e-6, "finite-difference d/dx")
+    norm = math.sqrt(x * x + y * y + z * z)
+    for got, want in zip(r["normal"], [x / norm, y / norm, z / norm]):
+        near(got, want, 1e-12, "outward normal")
+    if r["membership"] != 2 or r["attributes"] != {}:
+        sys.exit(f"FAIL: membership/attributes wrong: {r}")
+    outside = json.loads(run(ictk, ["eval", "sphere", "--at", "2,0,0,0.5", "--json"]).stdout)
+    if outside["membership"] != 0 or outside["point"][3] != 0.5:
+        sys.exit(f"FAIL: outside point: {outside}")
+    on = json.loads(run(ictk, ["eval", "sphere", "--at", "1,0,0", "--json"]).stdout)
+    if on["membership"] != 1:
+        sys.exit(f"FAIL: boundary point: {on}")
+    # Attributes of the heterogeneous walnut at a point of its shell on the x axis.
+    w = json.loads(run(ictk, ["eval", "walnut", "--at", "0.9,0,0", "--json"]).stdout)
+    attributes = w["attributes"]
+    if set(attributes) != {"material", "density", "colour"} or len(attributes["colour"]) != 3:
+        sys.exit(f"FAIL: walnut attributes: {attributes}")
+    near(attributes["material"], 1.0, 0, "walnut material in the shell")
+    near(attributes["density"], 1.2 - 0.4 * 0.9, 1e-12, "walnut density")
+
+
+def check_eval_plain(ictk, work):
+    out = run(ictk, ["eval", "sphere", "--at", "0.5,0,0"]).stdout.strip()
+    near(float(out), 0.75, 1e-15, "plain eval")
+
+
+def read_image(path):
+    import vtk
+    r = vtk.vtkXMLImageDataReader()
+    r.SetFileName(path)
+    r.Update()
+    return r.GetOutput()
+
+
+def read_polydata(path):
+    import vtk
+    r = vtk.vtkXMLPolyDataReader()
+    r.SetFileName(path)
+    r.Update()
+    return r.GetOutput()
+
+
+def no_leftovers(work):
+    left = [f for f in os.listdir(work) if ".tmp-" in f]
+    if left:
+        sys.exit(f"FAIL: temporary files left behind: {left}")
+
+
+def check_sample_sphere(ictk, work):
+    vti, vtp = os.path.join(work, "sphere.vti"), os.path.join(work, "sphere.vtp")
+    p = run(ictk, ["sample", "sphere", "-o", vti, "--dims", "21,17,13", "--bounds", "-1.2,1.2,-1,1,-1.5,1.5",
+                   "--threads", "2", "--surface", vtp])
+    if vti not in p.stdout or vtp not in p.stdout:
+        sys.exit(f"FAIL: the output paths are not printed:\n{p.stdout}")
+    image = read_image(vti)
+    if image.GetDimensions() != (21, 17, 13):
+        sys.exit(f"FAIL: dimensions {image.GetDimensions()}")
+    bounds = image.GetBounds()
+    for got, want in zip(bounds, (-1.2, 1.2, -1, 1, -1.5, 1.5)):
+        near(got, want, 1e-12, "bounds")
+    f = image.GetPointData().GetArray("f")
+    if f is None or f.GetDataType() != 10:  # VTK_FLOAT
+        sys.exit("FAIL: no float array 'f'")
+    for i in (0, 7, 1234, image.GetNumberOfPoints() // 2, image.GetNumberOfPoints() - 1):
+        x, y, z = image.GetPoint(i)
+        near(f.GetValue(i), 1 - x * x - y * y - z * z, 1e-6, f"f at point {i}")
+    surface = read_polydata(vtp)
+    if surface.GetNumberOfPolys() < 100:
+        sys.exit(f"FAIL: surface has {surface.GetNumberOfPolys()} triangles")
+    normals = surface.GetPointData().GetNormals()
+    for i in range(0, surface.GetNumberOfPoints(), 17):
+        x, y, z = surface.GetPoint(i)
+        near(math.sqrt(x * x + y * y + z * z), 1.0, 0.05, "surface point radius")
+        n = normals.GetTuple3(i)
+        if n[0] * x + n[1] * y + n[2] * z < 0.9:
+            sys.exit(f"FAIL: normal {n} at {(x, y, z)} does not point outwards")
+    # --double writes double arrays.
+    run(ictk, ["sample", "sphere", "-o", vti, "--resolution", "8", "--double"])
+    if read_image(vti).GetPointData().GetArray("f").GetDataType() != 11:  # VTK_DOUBLE
+        sys.exit("FAIL: --double did not write doubles")
+    no_leftovers(work)
+
+
+def check_sample_walnut(ictk, work):
+    vti = os.path.join(work, "walnut.vti")
+    run(ictk, ["sample", "walnut", "-o", vti, "--resolution", "24"])
+    image = read_image(vti)
+    if image.GetDimensions() != (24, 24, 24):
+        sys.exit(f"FAIL: dimensions {image.GetDimensions()}")
+    pd = image.GetPointData()
+    components = {pd.GetArrayName(i): pd.GetArray(i).GetNumberOfComponents() for i in range(pd.GetNumberOfArrays())}
+    if components != {"f": 1, "material": 1, "density": 1, "colour": 3}:
+        sys.exit(f"FAIL: arrays {components}")
+    material = set(pd.GetArray("material").GetValue(i) for i in range(image.GetNumberOfPoints()))
+    if not {-1.0, 1.0, 2.0} <= material:
+        sys.exit(f"FAIL: material values {material}")
+    # The corner is outside: material -1, colour 0.
+    if pd.GetArray("material").GetValue(0) != -1.0 or pd.GetArray("colour").GetTuple3(0) != (0, 0, 0):
+        sys.exit("FAIL: outside defaults at the corner")
+    no_leftovers(work)
+
+
+def check_sample_disk2d(ictk, work):
+    vti = os.path.join(work, "disk.vti")
+    run(ictk, ["sample", "disk2d", "-o", vti, "--resolution", "9"])
+    image = read_image(vti)
+    if image.GetDimensions() != (9, 9, 1):
+        sys.exit(f"FAIL: a 2D model gives {image.GetDimensions()}, not (9, 9, 1)")
+
+
+def check_error(ictk, work, pattern, args):
+    args = [a.replace("@WORK@", work) for a in args if a != ""]
+    p = run(ictk, args, check=False)
+    if p.returncode != 2:
+        sys.exit(f"FAIL: ictk {' '.join(args)} exited {p.returncode}, not 2\nstderr:\n{p.stderr}")
+    lines = [l for l in p.stderr.splitlines() if l.strip()]
+    if len(lines) != 1 or not lines[0].startswith("ictk: error: "):
+        sys.exit(f"FAIL: expected one 'ictk: error:' line, got:\n{p.stderr}")
+    if not re.search(pattern, lines[0]):
+        sys.exit(f"FAIL: {lines[0]!r} does not match {pattern!r}")
+    if os.path.exists(os.path.join(work, "x.vti")):
+        sys.exit("FAIL: an output file was written despite the error")
+    no_leftovers(work)
+
+
+def main():
+    # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
+    argv = sys.argv[1:]
+    if len(argv) < 5 or argv[0] != "--ictk" or argv[2] != "--work":
+        sys.exit(__doc__)
+    ictk, work, check, rest = argv[1], argv[3], argv[4], argv[5:]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    checks = {
+        "models": check_models,
+        "eval-json": check_eval_json,
+        "eval-plain": check_eval_plain,
+        "sample-sphere": check_sample_sphere,
+        "sample-walnut": check_sample_walnut,
+        "sample-disk2d": check_sample_disk2d,
+    }
+    if check == "expect-error":
+        if len(rest) < 2 or rest[1] != "--":
+            sys.exit("usage: expect-error REGEX -- ICTK-ARGS...")
+        check_error(ictk, work, rest[0], rest[2:])
+    elif check in checks:
+        checks[check](ictk, work)
+    else:
+        sys.exit(f"unknown check {check!r}")
+    print("OK")
+
+
+if __name__ == "__main__":
+    main()
