@@ -19,6 +19,7 @@
 #include <vtkCallbackCommand.h>
 #include <vtkCommand.h>
 #include <vtkDataObject.h>
+#include <vtkFloatArray.h>
 #include <vtkFlyingEdges3D.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
@@ -501,6 +502,66 @@ int RunEval(const EvalOptions& o)
   return 0;
 }
 
+
+// Evaluates the hypervolume's attributes at every vertex of a boundary surface, taken from the
+// inside of the solid: each vertex (on f = 0 only up to Flying Edges' linear interpolation) is moved
+// by a few Newton steps along the gradient to where f is just positive, about `inset` inside.
+// Arrays are named as the attributes, with their component counts.
+void AttachBoundaryAttributes(vtkPolyData* surface, const frep::Hypervolume& hv,
+  const std::vector<double>& params, double time, double inset)
+{
+  if (hv.attributes().empty() || surface->GetNumberOfPoints() == 0)
+  {
+    return;
+  }
+  frep::HypervolumeEvaluator evaluator(hv, params);
+  frep::GradientEvaluator gradient(frep::Tape::compile(hv.geometry().function()), params);
+  std::vector<vtkSmartPointer<vtkFloatArray>> arrays;
+  for (const frep::Attribute& a : hv.attributes())
+  {
+    auto array = vtkSmartPointer<vtkFloatArray>::New();
+    array->SetName(a.name.c_str());
+    array->SetNumberOfComponents(static_cast<int>(a.components.size()));
+    array->SetNumberOfTuples(surface->GetNumberOfPoints());
+    arrays.push_back(array);
+  }
+  std::vector<double> values(hv.attributeComponentCount());
+  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
+  {
+    double p[3];
+    surface->GetPoint(i, p);
+    for (int iteration = 0; iteration < 4; ++iteration)
+    {
+      const frep::ValueGradient g = gradient.eval(p[0], p[1], p[2], time);
+      const double g2 = g.gradient[0] * g.gradient[0] + g.gradient[1] * g.gradient[1] +
+        g.gradient[2] * g.gradient[2];
+      const double target = hv.threshold() + inset * std::sqrt(g2);
+      if (!(g2 > 0) || !std::isfinite(g.value) || g.value >= target)
+      {
+        break;
+      }
+      for (int k = 0; k < 3; ++k)
+      {
+        p[k] += (target - g.value) * g.gradient[k] / g2;
+      }
+    }
+    double f;
+    evaluator.eval({ p[0], p[1], p[2], time }, f, values.data());
+    std::size_t k = 0;
+    for (auto& array : arrays)
+    {
+      for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+      {
+        array->SetTypedComponent(i, c, static_cast<float>(values[k++]));
+      }
+    }
+  }
+  for (auto& array : arrays)
+  {
+    surface->GetPointData()->AddArray(array);
+  }
+}
+
 struct SampleCommandOptions
 {
   std::string Model;
@@ -698,11 +759,16 @@ int RunSample(const SampleCommandOptions& o)
     // f grows inwards, so the negated gradient Flying Edges uses for normals points outwards.
     contour->ComputeNormalsOn();
     contour->ComputeScalarsOff();
-    contour->InterpolateAttributesOn();
+    contour->InterpolateAttributesOff();
     errorsBefore = messages->Errors.size();
     contour->Update();
     ThrowIfVtkFailed(messages, errorsBefore, "surface extraction failed");
     vtkPolyData* surface = contour->GetOutput();
+    // Interpolating the grid's attribute arrays would mix the values on both sides of the
+    // boundary (an attribute usually jumps there); evaluate them instead just inside the solid,
+    // a thousandth of a grid step from each vertex against its outward normal.
+    const double step = std::min({ grid.spacing[0], grid.spacing[1], grid.spacing[2] });
+    AttachBoundaryAttributes(surface, hv, params, o.Time, 1e-3 * step);
 
     vtkNew<vtkXMLPolyDataWriter> surfaceWriter;
     surfaceWriter->SetInputData(surface);

@@ -151,6 +151,17 @@ def check_sample_walnut(ictk, work):
     # The corner is outside: material -1, colour 0.
     if pd.GetArray("material").GetValue(0) != -1.0 or pd.GetArray("colour").GetTuple3(0) != (0, 0, 0):
         sys.exit("FAIL: outside defaults at the corner")
+    # Surface attributes are taken from inside the solid: the shell's and the kernel's boundaries
+    # carry materials 1 and 2 only, never the outside default -1 nor a blend of both sides.
+    vtp = os.path.join(work, "walnut.vtp")
+    run(ictk, ["sample", "walnut", "-o", vti, "--resolution", "48", "--surface", vtp])
+    surface = read_polydata(vtp)
+    material = surface.GetPointData().GetArray("material")
+    if material is None or surface.GetPointData().GetArray("colour").GetNumberOfComponents() != 3:
+        sys.exit("FAIL: surface attribute arrays missing")
+    values = {material.GetValue(i) for i in range(surface.GetNumberOfPoints())}
+    if values != {1.0, 2.0}:
+        sys.exit(f"FAIL: surface material values {values}, expected {{1, 2}}")
     no_leftovers(work)
 
 
