@@ -1,0 +1,60 @@
+"""The Python package `ictk` in VTK pipelines (run with Debian's /usr/bin/python3)."""
+import math
+import sys
+
+import vtk
+from ictk import ictkFiltersFRep
+
+
+def check(condition, message):
+    if not condition:
+        sys.exit("FAIL: " + message)
+
+
+# The sampler as a pipeline source: the unit sphere f = 1 - x^2 - y^2 - z^2.
+sampler = ictkFiltersFRep.ictkFRepSampler()
+sampler.SetModelName("sphere")
+sampler.SetSampleDimensions(5, 5, 5)
+sampler.Update()
+image = sampler.GetOutput()
+check(image.GetDimensions() == (5, 5, 5), f"dimensions {image.GetDimensions()}")
+f = image.GetPointData().GetArray("f")
+for i in range(image.GetNumberOfPoints()):
+    x, y, z = image.GetPoint(i)
+    check(abs(f.GetTuple1(i) - (1 - x * x - y * y - z * z)) < 1e-6, f"f at point {i}")
+
+# Sampler -> Flying Edges -> mass properties: the volume and area of the unit sphere.
+sampler.SetSampleDimensions(96, 96, 96)
+contour = vtk.vtkFlyingEdges3D()
+contour.SetInputConnection(sampler.GetOutputPort())
+contour.SetValue(0, 0.0)
+mass = vtk.vtkMassProperties()
+mass.SetInputConnection(contour.GetOutputPort())
+mass.Update()
+check(abs(mass.GetVolume() - 4 / 3 * math.pi) < 0.01 * 4 / 3 * math.pi, f"volume {mass.GetVolume()}")
+check(abs(mass.GetSurfaceArea() - 4 * math.pi) < 0.01 * 4 * math.pi, f"area {mass.GetSurfaceArea()}")
+
+# The implicit-function adaptor in VTK's own filters (negative inside, as VTK expects).
+function = ictkFiltersFRep.ictkFRepImplicitFunction()
+function.SetModelName("sphere")
+check(abs(function.EvaluateFunction(0.5, 0, 0) + 0.75) < 1e-12, "implicit function value")
+gradient = [0.0, 0.0, 0.0]
+function.EvaluateGradient([0.5, 0.0, 0.0], gradient)
+check(max(abs(g - e) for g, e in zip(gradient, (1.0, 0.0, 0.0))) < 1e-12, f"gradient {gradient}")
+plane = vtk.vtkPlaneSource()
+plane.SetOrigin(-2, -2, 0)
+plane.SetPoint1(2, -2, 0)
+plane.SetPoint2(-2, 2, 0)
+plane.SetResolution(200, 200)
+triangles = vtk.vtkTriangleFilter()
+triangles.SetInputConnection(plane.GetOutputPort())
+clip = vtk.vtkClipPolyData()
+clip.SetInputConnection(triangles.GetOutputPort())
+clip.SetClipFunction(function)
+clip.InsideOutOn()
+area = vtk.vtkMassProperties()
+area.SetInputConnection(clip.GetOutputPort())
+area.Update()
+# The z = 0 section of the unit sphere is the unit disk.
+check(abs(area.GetSurfaceArea() - math.pi) < 0.005 * math.pi, f"clipped area {area.GetSurfaceArea()}")
+print("python wrapping: all checks passed")
