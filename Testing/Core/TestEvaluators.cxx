@@ -423,3 +423,49 @@ TEST(Evaluators, RUnionAtTheZeroSetIsNotFlaggedNaN)
   EXPECT_LE(r.lo, -2.0 + std::sqrt(2.0));
   EXPECT_GE(r.hi, 2.0 + std::sqrt(2.0));
 }
+
+TEST(Sampling, HypervolumeInOnePassMatchesPointEvaluation)
+{
+  // A ball with a density on the half x >= 0 and a colour everywhere in the ball.
+  const Shape ball(Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "ball");
+  Hypervolume hv(ball);
+  Attribute density;
+  density.name = "density";
+  density.components = { Expr(10.0) + Expr::z() };
+  density.partition = Expr::x();
+  density.insideDefault = { 1.0 };
+  density.outsideDefault = { -1.0 };
+  hv.addAttribute(density);
+  Attribute colour;
+  colour.name = "colour";
+  colour.components = { Expr(1.0), abs(Expr::y()), max(Expr::x(), Expr::z()) };
+  colour.partition = ball.function();
+  colour.outsideDefault = { 0.0, 0.0, 0.5 };
+  hv.addAttribute(colour);
+  const Grid grid = gridOverBox({ -1.3, -1.3, -1.3 }, { 1.3, 1.3, 1.3 }, { 19, 17, 15 });
+  const auto n = static_cast<std::size_t>(grid.pointCount());
+  std::vector<double> f(n), d(n), c(3 * n);
+  SampleOptions options;
+  options.brickSize = 4;
+  sampleGrid(hv, grid, f.data(), { d.data(), c.data() }, options);
+  HypervolumeEvaluator ev(hv);
+  std::size_t idx = 0;
+  std::size_t defaults = 0;
+  for (std::int64_t k = 0; k < grid.dimensions[2]; ++k)
+    for (std::int64_t j = 0; j < grid.dimensions[1]; ++j)
+      for (std::int64_t i = 0; i < grid.dimensions[0]; ++i, ++idx)
+      {
+        double value, attributes[4];
+        ev.eval({ grid.origin[0] + i * grid.spacing[0], grid.origin[1] + j * grid.spacing[1],
+                  grid.origin[2] + k * grid.spacing[2], 0 },
+          value, attributes);
+        ASSERT_EQ(f[idx], value);
+        ASSERT_EQ(d[idx], attributes[0]);
+        ASSERT_EQ(c[3 * idx + 0], attributes[1]);
+        ASSERT_EQ(c[3 * idx + 1], attributes[2]);
+        ASSERT_EQ(c[3 * idx + 2], attributes[3]);
+        defaults += attributes[0] == 1.0 || attributes[0] == -1.0;
+      }
+  EXPECT_GT(defaults, n / 4); // both defaults are exercised (half the box has x < 0)
+  EXPECT_THROW(sampleGrid(hv, grid, f.data(), { d.data() }), std::invalid_argument);
+}

@@ -263,19 +263,32 @@ void BatchEvaluator<T>::eval(const T* x, const T* y, const T* z, const T* t, T* 
 }
 
 template <typename T>
-void BatchEvaluator<T>::evalRowX(
-  double x0, double dx, std::int64_t first, double y, double z, double t, T* out, std::size_t n)
+void BatchEvaluator<T>::evalRowX(double x0, double dx, std::int64_t first, double y, double z,
+  double t, T* const* outputs, std::size_t outputCount, std::size_t n)
 {
+  if (outputCount > row_.outputs.size())
+  {
+    throw std::invalid_argument("BatchEvaluator::evalRowX: the tape has " +
+      std::to_string(row_.outputs.size()) + " output(s), " + std::to_string(outputCount) + " asked");
+  }
   T* s = scalars_.data();
   s[0] = static_cast<T>(x0 + static_cast<double>(first) * dx);
   s[1] = static_cast<T>(y);
   s[2] = static_cast<T>(z);
   s[3] = static_cast<T>(t);
   runScalar(row_.uniform, s);
-  const RowProgram::Output& output = row_.outputs[0];
-  if (!output.varying)
+  bool anyVarying = false;
+  for (std::size_t k = 0; k < outputCount; ++k)
   {
-    std::fill_n(out, n, s[output.slot]);
+    const RowProgram::Output& output = row_.outputs[k];
+    if (!output.varying)
+    {
+      std::fill_n(outputs[k], n, s[output.slot]);
+    }
+    anyVarying = anyVarying || output.varying;
+  }
+  if (!anyVarying)
+  {
     return;
   }
   for (const auto& [scalar, chunk] : row_.broadcasts)
@@ -298,7 +311,13 @@ void BatchEvaluator<T>::evalRowX(
       rowX_ = key;
     }
     runChunk<T>(row_.varying, rowSlots_.data(), m);
-    std::copy_n(rowSlots_[output.slot], m, out + start);
+    for (std::size_t k = 0; k < outputCount; ++k)
+    {
+      if (row_.outputs[k].varying)
+      {
+        std::copy_n(rowSlots_[row_.outputs[k].slot], m, outputs[k] + start);
+      }
+    }
   }
 }
 

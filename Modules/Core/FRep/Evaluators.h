@@ -46,7 +46,14 @@ public:
   /// double exactly so. Instructions that do not depend on x run once for the row. Gives the same
   /// values as eval() on those points.
   void evalRowX(double x0, double dx, std::int64_t first, double y, double z, double t, T* out,
-    std::size_t n);
+    std::size_t n)
+  {
+    evalRowX(x0, dx, first, y, z, t, &out, 1, n);
+  }
+  /// The same for the first `outputCount` outputs of the tape: outputs[k] receives output k
+  /// (n values each).
+  void evalRowX(double x0, double dx, std::int64_t first, double y, double z, double t,
+    T* const* outputs, std::size_t outputCount, std::size_t n);
   /// Replaces the tape (e.g. by a region's simplified tape) keeping the parameters.
   void setTape(TapePtr tape);
   const TapePtr& tape() const { return tape_; }

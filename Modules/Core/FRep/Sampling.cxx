@@ -132,10 +132,13 @@ struct Workspace
   std::size_t next = 0;
 };
 
-template <typename T>
-void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& options)
+// Runs `writeRow(evaluator, offset, i0, n, y, z)` for every grid row segment of every brick, in
+// parallel; `offset` is the index of the segment's first point in VTK point order.
+template <typename T, typename RowWriter>
+void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint,
+  const SampleOptions& options, const RowWriter& writeRow)
 {
-  checkGrid(grid, sizeof(T));
+  checkGrid(grid, bytesPerPoint);
   if (tape->parameterCount() > options.parameters.size())
   {
     throw std::invalid_argument("sampleGrid: the model has " +
@@ -189,9 +192,7 @@ void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& 
       for (std::int64_t j = j0; j < j1; ++j)
       {
         const double y = grid.origin[1] + j * grid.spacing[1];
-        T* row = out + (k * dims[1] + j) * dims[0] + i0;
-        evaluator->evalRowX(grid.origin[0], grid.spacing[0], i0, y, z, grid.time, row,
-          static_cast<std::size_t>(i1 - i0));
+        writeRow(*evaluator, (k * dims[1] + j) * dims[0] + i0, i0, static_cast<std::size_t>(i1 - i0), y, z);
       }
     }
   };
@@ -237,6 +238,67 @@ void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& 
     options.progress(1.0);
   }
 }
+template <typename T>
+void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& options)
+{
+  sampleRows<T>(tape, grid, sizeof(T), options,
+    [&](BatchEvaluator<T>& evaluator, std::int64_t offset, std::int64_t i0, std::size_t n, double y,
+      double z)
+    { evaluator.evalRowX(grid.origin[0], grid.spacing[0], i0, y, z, grid.time, out + offset, n); });
+}
+
+template <typename T>
+void sampleHypervolume(const Hypervolume& hv, const Grid& grid, T* value,
+  const std::vector<T*>& attributes, const SampleOptions& options)
+{
+  if (attributes.size() != hv.attributes().size())
+  {
+    throw std::invalid_argument("sampleHypervolume: the hypervolume has " +
+      std::to_string(hv.attributes().size()) + " attribute(s) but " +
+      std::to_string(attributes.size()) + " array(s) were given");
+  }
+  // One tape for the geometry, the partitions and the attribute functions: what they share is
+  // computed once per point.
+  const TapePtr tape = hv.compile();
+  const std::size_t outputCount = tape->outputs().size();
+  const T threshold = static_cast<T>(hv.threshold());
+  tbb::enumerable_thread_specific<std::vector<T>> buffers;
+  sampleRows<T>(tape, grid, (1 + hv.attributeComponentCount()) * sizeof(T), options,
+    [&](BatchEvaluator<T>& evaluator, std::int64_t offset, std::int64_t i0, std::size_t n, double y,
+      double z)
+    {
+      std::vector<T>& buffer = buffers.local();
+      buffer.resize(outputCount * n);
+      std::vector<T*> rows(outputCount);
+      rows[0] = value + offset;
+      for (std::size_t k = 1; k < outputCount; ++k)
+      {
+        rows[k] = buffer.data() + k * n;
+      }
+      evaluator.evalRowX(grid.origin[0], grid.spacing[0], i0, y, z, grid.time, rows.data(), outputCount, n);
+      // The default rule of HypervolumeEvaluator (thesis L715, consistent reading).
+      const T* f = rows[0];
+      std::size_t k = 1;
+      for (std::size_t a = 0; a < attributes.size(); ++a)
+      {
+        const Attribute& attribute = hv.attributes()[a];
+        const std::size_t components = attribute.components.size();
+        const T* partition = rows[k++];
+        T* destination = attributes[a] + offset * static_cast<std::int64_t>(components);
+        for (std::size_t c = 0; c < components; ++c, ++k)
+        {
+          const T* function = rows[k];
+          const T inside = static_cast<T>(attribute.insideDefault[c]);
+          const T outside = static_cast<T>(attribute.outsideDefault[c]);
+          for (std::size_t i = 0; i < n; ++i)
+          {
+            destination[i * components + c] =
+              partition[i] >= 0 ? function[i] : (f[i] >= threshold ? inside : outside);
+          }
+        }
+      }
+    });
+}
 } // namespace
 
 void sampleGrid(const TapePtr& tape, const Grid& grid, float* out, const SampleOptions& options)
@@ -247,6 +309,18 @@ void sampleGrid(const TapePtr& tape, const Grid& grid, float* out, const SampleO
 void sampleGrid(const TapePtr& tape, const Grid& grid, double* out, const SampleOptions& options)
 {
   sample(tape, grid, out, options);
+}
+
+void sampleGrid(const Hypervolume& hv, const Grid& grid, float* value,
+  const std::vector<float*>& attributes, const SampleOptions& options)
+{
+  sampleHypervolume(hv, grid, value, attributes, options);
+}
+
+void sampleGrid(const Hypervolume& hv, const Grid& grid, double* value,
+  const std::vector<double*>& attributes, const SampleOptions& options)
+{
+  sampleHypervolume(hv, grid, value, attributes, options);
 }
 
 } // namespace ictk::frep

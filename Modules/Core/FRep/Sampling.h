@@ -5,6 +5,7 @@
 // equivalent, pruned) tape, whatever thread runs it.
 
 #include "FRep/Evaluators.h"
+#include "FRep/Hypervolume.h"
 
 #include <array>
 #include <atomic>
@@ -60,5 +61,13 @@ struct SampleOptions
 /// Fills `out` (grid.pointCount() values) with the tape's first output.
 void sampleGrid(const TapePtr& tape, const Grid& grid, float* out, const SampleOptions& options = {});
 void sampleGrid(const TapePtr& tape, const Grid& grid, double* out, const SampleOptions& options = {});
+
+/// Samples a hypervolume in one pass: f into `value` (grid.pointCount() values) and attribute i
+/// into attributes[i] (grid.pointCount() tuples of its component count, interleaved), by the
+/// default rule of HypervolumeEvaluator applied to the values in T.
+void sampleGrid(const Hypervolume& hv, const Grid& grid, float* value,
+  const std::vector<float*>& attributes, const SampleOptions& options = {});
+void sampleGrid(const Hypervolume& hv, const Grid& grid, double* value,
+  const std::vector<double*>& attributes, const SampleOptions& options = {});
 
 } // namespace ictk::frep

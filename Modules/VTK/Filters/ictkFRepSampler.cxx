@@ -100,15 +100,6 @@ bool BoundsAreSet(const double b[6])
   return b[0] <= b[1] && b[2] <= b[3] && b[4] <= b[5];
 }
 
-/// The function sampled for one attribute component: the hypervolume default rule written as an
-/// expression, so that it runs through the same multithreaded grid sampler as f.
-frep::Expr AttributeField(const frep::Hypervolume& hv, const frep::Attribute& a, std::size_t c)
-{
-  const frep::Expr inGeometry = hv.geometry().function() - frep::Expr(hv.threshold());
-  return frep::select(a.partition, a.components[c],
-    frep::select(inGeometry, frep::Expr(a.insideDefault[c]), frep::Expr(a.outsideDefault[c])));
-}
-
 template <typename T>
 vtkSmartPointer<vtkAOSDataArrayTemplate<T>> NewArray(
   const std::string& name, int components, std::int64_t tuples)
@@ -238,14 +229,6 @@ bool ictkFRepSampler::Internals::MakePlan(ictkFRepSampler* self, Plan& plan, std
   if (self->GetComputeAttributes())
   {
     values += plan.hv->attributeComponentCount();
-    for (const frep::Attribute& a : plan.hv->attributes())
-    {
-      if (a.components.size() > 1)
-      {
-        values += 1; // the scratch component interleaved into a multi-component array
-        break;
-      }
-    }
   }
   plan.bytesPerPoint = values * valueSize;
   try
@@ -287,82 +270,36 @@ template <typename T>
 void Sample(ictkFRepSampler* self, const Plan& plan, const std::vector<double>& parameters,
   int threads, vtkImageData* output)
 {
-  const frep::Hypervolume& hv = *plan.hv;
   const std::int64_t n = plan.grid.pointCount();
-
-  // One pass per sampled function: f, then each attribute component.
-  struct Pass
-  {
-    frep::Expr field;
-    std::size_t attribute;
-    std::size_t component;
-  };
-  std::vector<Pass> passes{ { hv.geometry().function(), 0, 0 } };
-  if (self->GetComputeAttributes())
-  {
-    for (std::size_t i = 0; i < hv.attributes().size(); ++i)
-    {
-      const frep::Attribute& a = hv.attributes()[i];
-      for (std::size_t c = 0; c < a.components.size(); ++c)
-      {
-        passes.push_back({ AttributeField(hv, a, c), i, c });
-      }
-    }
-  }
+  // Without attributes, sample the geometry alone (a hypervolume with no attribute).
+  const frep::Hypervolume hv =
+    self->GetComputeAttributes() ? *plan.hv : frep::Hypervolume(plan.hv->geometry(), plan.hv->threshold());
 
   auto f = NewArray<T>("f", 1, n);
   std::vector<vtkSmartPointer<vtkAOSDataArrayTemplate<T>>> attributeArrays;
-  std::vector<T> scratch;
-  if (self->GetComputeAttributes())
+  std::vector<T*> attributePointers;
+  for (const frep::Attribute& a : hv.attributes())
   {
-    for (const frep::Attribute& a : hv.attributes())
-    {
-      const int components = static_cast<int>(a.components.size());
-      // "f" is the field; an attribute of that name must not hide it.
-      const std::string name = a.name == "f" ? "attribute_f" : a.name;
-      attributeArrays.push_back(NewArray<T>(name, components, n));
-      if (components > 1 && scratch.empty())
-      {
-        scratch.resize(static_cast<std::size_t>(n));
-      }
-    }
+    // "f" is the field; an attribute of that name must not hide it.
+    const std::string name = a.name == "f" ? "attribute_f" : a.name;
+    attributeArrays.push_back(NewArray<T>(name, static_cast<int>(a.components.size()), n));
+    attributePointers.push_back(attributeArrays.back()->GetPointer(0));
   }
 
   frep::SampleOptions options;
   options.threads = threads;
   options.parameters = parameters;
-  for (std::size_t p = 0; p < passes.size(); ++p)
+  options.progress = [self](double fraction)
   {
-    const double passCount = static_cast<double>(passes.size());
-    options.progress = [self, p, passCount](double fraction)
-    {
-      self->UpdateProgress((static_cast<double>(p) + fraction) / passCount);
-      return !self->GetAbortExecute();
-    };
-    if (self->GetAbortExecute())
-    {
-      throw frep::Cancelled();
-    }
-    const frep::TapePtr tape = frep::Tape::compile(passes[p].field);
-    if (p == 0)
-    {
-      frep::sampleGrid(tape, plan.grid, f->GetPointer(0), options);
-      continue;
-    }
-    auto& array = attributeArrays[passes[p].attribute];
-    const int components = array->GetNumberOfComponents();
-    if (components == 1)
-    {
-      frep::sampleGrid(tape, plan.grid, array->GetPointer(0), options);
-      continue;
-    }
-    frep::sampleGrid(tape, plan.grid, scratch.data(), options);
-    T* out = array->GetPointer(0) + passes[p].component;
-    for (std::int64_t i = 0; i < n; ++i)
-    {
-      out[i * components] = scratch[static_cast<std::size_t>(i)];
-    }
+    self->UpdateProgress(fraction);
+    return !self->GetAbortExecute();
+  };
+  if (self->GetAbortExecute())
+  {
+    throw frep::Cancelled();
   }
+  // Geometry and attributes in one pass over one tape (shared sub-expressions computed once).
+  frep::sampleGrid(hv, plan.grid, f->GetPointer(0), attributePointers, options);
 
   const auto& d = plan.grid.dimensions;
   output->SetExtent(
