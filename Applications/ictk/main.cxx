@@ -502,10 +502,9 @@ int RunEval(const EvalOptions& o)
   return 0;
 }
 
-
 // Evaluates the hypervolume's attributes at every vertex of a boundary surface, taken from the
-// inside of the solid: each vertex (on f = 0 only up to Flying Edges' linear interpolation) is moved
-// by a few Newton steps along the gradient to where f is just positive, about `inset` inside.
+// inside of the solid: each vertex (on f = 0 only up to Flying Edges' linear interpolation) is
+// moved by a few Newton steps along the gradient to where f is just positive, about `inset` inside.
 // Arrays are named as the attributes, with their component counts.
 void AttachBoundaryAttributes(vtkPolyData* surface, const frep::Hypervolume& hv,
   const std::vector<double>& params, double time, double inset)

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // ICTK's grid sampling (sampleGrid, float output, all threads) against VTK's vtkSampleFunction on
-// the same models, bounds and dimensions. sphere, csg3 and random1000 are built in VTK from the very
-// recipes the ICTK models come from (vtkSphere, vtkBox, vtkCylinder, vtkImplicitBoolean); blend100
-// has no VTK equivalent. Before timing, both fields are sampled once and compared (ICTK = -VTK),
-// so that the two sides compute the same thing.
+// the same models, bounds and dimensions. sphere, csg3 and random1000 are built in VTK from the
+// very recipes the ICTK models come from (vtkSphere, vtkBox, vtkCylinder, vtkImplicitBoolean);
+// blend100 has no VTK equivalent. Before timing, both fields are sampled once and compared (ICTK =
+// -VTK), so that the two sides compute the same thing.
 //
 //   ictkBenchFRep             all models at 128^3 and 256^3
 //   ictkBenchFRep --quick     128^3 only, two iterations per case
@@ -168,9 +168,9 @@ void benchVtk(benchmark::State& state, const std::string& model, std::int64_t n)
     sample->Update();
     benchmark::DoNotOptimize(sample->GetOutput()->GetScalarPointer());
   }
-  state.counters["points/s"] = benchmark::Counter(static_cast<double>(n * n * n) *
-      static_cast<double>(state.iterations()),
-    benchmark::Counter::kIsRate);
+  state.counters["points/s"] =
+    benchmark::Counter(static_cast<double>(n * n * n) * static_cast<double>(state.iterations()),
+      benchmark::Counter::kIsRate);
 }
 
 // ICTK's float field must be minus VTK's at the grid points. Returns false on a mismatch.
@@ -215,8 +215,9 @@ bool verify(const std::string& model, std::int64_t n)
   // intermediate (|p|^2 ~ 4 here) is the expected disagreement.
   const double tolerance = 1e-5 * std::max(1.0, range);
   const bool ok = worst <= tolerance && geometry < 1e-12;
-  std::printf("verify %-10s %lld^3: ICTK = -VTK at %lld points, max |ICTK + VTK| = %.3g at point %lld "
-              "(|field| <= %.3g, tolerance %.3g), grid geometry difference %.3g: %s\n",
+  std::printf(
+    "verify %-10s %lld^3: ICTK = -VTK at %lld points, max |ICTK + VTK| = %.3g at point %lld "
+    "(|field| <= %.3g, tolerance %.3g), grid geometry difference %.3g: %s\n",
     model.c_str(), static_cast<long long>(n), static_cast<long long>(compared), worst,
     static_cast<long long>(worstIndex), range, tolerance, geometry, ok ? "OK" : "MISMATCH");
   return ok;
@@ -358,8 +359,8 @@ int main(int argc, char** argv)
     }
   }
 
-  const std::vector<std::int64_t> sizes = quick ? std::vector<std::int64_t>{ 128 }
-                                                : std::vector<std::int64_t>{ 128, 256 };
+  const std::vector<std::int64_t> sizes =
+    quick ? std::vector<std::int64_t>{ 128 } : std::vector<std::int64_t>{ 128, 256 };
   for (const char* model : Models)
   {
     for (std::int64_t n : sizes)

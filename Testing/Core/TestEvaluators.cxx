@@ -136,8 +136,8 @@ TEST(Evaluators, RowEvaluationMatchesPointEvaluation)
     PointEvaluator point(tape);
     BatchEvaluator<double> batch(tape);
     BatchEvaluator<float> batchF(tape);
-    const double x0 = rng.uniform(-3, 0), dx = 0.013, y = rng.uniform(-3, 3), z = rng.uniform(-3, 3),
-                 t = rng.uniform(-3, 3);
+    const double x0 = rng.uniform(-3, 0), dx = 0.013, y = rng.uniform(-3, 3),
+                 z = rng.uniform(-3, 3), t = rng.uniform(-3, 3);
     std::vector<double> row(600);
     std::vector<float> rowF(600);
     batch.evalRowX(x0, dx, 0, y, z, t, row.data(), row.size());
@@ -210,10 +210,12 @@ TEST(Evaluators, GradientMatchesFiniteDifferences)
         auto q = p, r = p;
         q[a] += h;
         r[a] -= h;
-        const double fd = (point.eval(q[0], q[1], q[2], q[3]) - point.eval(r[0], r[1], r[2], r[3])) / (2 * h);
+        const double fd =
+          (point.eval(q[0], q[1], q[2], q[3]) - point.eval(r[0], r[1], r[2], r[3])) / (2 * h);
         if (std::isfinite(fd) && std::fabs(fd) < 1e4)
         {
-          EXPECT_NEAR(g.gradient[a], fd, 1e-4 * (1 + std::fabs(fd))) << toString(e) << " axis " << a;
+          EXPECT_NEAR(g.gradient[a], fd, 1e-4 * (1 + std::fabs(fd)))
+            << toString(e) << " axis " << a;
         }
       }
     }
@@ -263,7 +265,9 @@ TEST(Evaluators, IntervalsEnclosePointSamplesAndPruningKeepsValues)
         std::array<double, 4> p;
         for (int a = 0; a < 4; ++a)
         {
-          p[a] = s == 0 ? region.axes[a].lo : (s == 1 ? region.axes[a].hi : rng.uniform(region.axes[a].lo, region.axes[a].hi));
+          p[a] = s == 0
+            ? region.axes[a].lo
+            : (s == 1 ? region.axes[a].hi : rng.uniform(region.axes[a].lo, region.axes[a].hi));
         }
         const double v = point.eval(p[0], p[1], p[2], p[3]);
         if (std::isfinite(v))
@@ -289,7 +293,8 @@ TEST(Evaluators, PruningCutsTheLosingBranchOfAUnion)
   const TapePtr tape = Tape::compile(max(left, right));
   IntervalEvaluator interval(tape);
   Region region;
-  region.axes = { Interval{ 1.5, 2.5 }, Interval{ -0.5, 0.5 }, Interval{ -0.5, 0.5 }, Interval{ 0, 0 } };
+  region.axes = { Interval{ 1.5, 2.5 }, Interval{ -0.5, 0.5 }, Interval{ -0.5, 0.5 },
+    Interval{ 0, 0 } };
   const Interval r = interval.eval(region);
   EXPECT_EQ(interval.choices().back(), Choice::Second);
   const TapePtr pruned = interval.simplified();
@@ -317,7 +322,8 @@ TEST(Evaluators, MultipleOutputsAndParameters)
 TEST(Hypervolume, AttributeDefaultsFollowTheConsistentReadingOfL715)
 {
   // Unit sphere with a density partition g = x (only the half x >= 0 has the function S = 10 + z).
-  const Shape ball(Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "ball");
+  const Shape ball(
+    Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "ball");
   Hypervolume hv(ball);
   Attribute density;
   density.name = "density";
@@ -351,8 +357,8 @@ TEST(Hypervolume, AttributeDefaultsFollowTheConsistentReadingOfL715)
 TEST(Sampling, GridValuesEqualPointEvaluationForAnyThreadCount)
 {
   Random rng(6);
-  const Expr e = max(randomTree(rng, 7, false), min(Expr(1.0) - square(Expr::x()) - square(Expr::y()),
-                                                  Expr(0.5) - square(Expr::z())));
+  const Expr e = max(randomTree(rng, 7, false),
+    min(Expr(1.0) - square(Expr::x()) - square(Expr::y()), Expr(0.5) - square(Expr::z())));
   const TapePtr tape = Tape::compile(e);
   const Grid grid = gridOverBox({ -2, -2, -2 }, { 2, 2, 2 }, { 37, 29, 23 }, 0.25);
   std::vector<double> one(grid.pointCount()), two(grid.pointCount()), flat(grid.pointCount());
@@ -369,7 +375,8 @@ TEST(Sampling, GridValuesEqualPointEvaluationForAnyThreadCount)
     for (std::int64_t j = 0; j < grid.dimensions[1]; ++j)
       for (std::int64_t i = 0; i < grid.dimensions[0]; ++i)
       {
-        const std::size_t idx = static_cast<std::size_t>((k * grid.dimensions[1] + j) * grid.dimensions[0] + i);
+        const std::size_t idx =
+          static_cast<std::size_t>((k * grid.dimensions[1] + j) * grid.dimensions[0] + i);
         const double v = point.eval(grid.origin[0] + i * grid.spacing[0],
           grid.origin[1] + j * grid.spacing[1], grid.origin[2] + k * grid.spacing[2], 0.25);
         ASSERT_TRUE(sameDouble(v, one[idx])) << i << " " << j << " " << k;
@@ -403,7 +410,10 @@ TEST(Sampling, BadGridsAndCancellation)
   SampleOptions options;
   options.brickSize = 4;
   int calls = 0;
-  options.progress = [&](double) { return ++calls < 3; };
+  options.progress = [&](double)
+  {
+    return ++calls < 3;
+  };
   EXPECT_THROW(sampleGrid(tape, grid, big.data(), options), Cancelled);
   EXPECT_EQ(calls, 3);
 }
@@ -427,7 +437,8 @@ TEST(Evaluators, RUnionAtTheZeroSetIsNotFlaggedNaN)
 TEST(Sampling, HypervolumeInOnePassMatchesPointEvaluation)
 {
   // A ball with a density on the half x >= 0 and a colour everywhere in the ball.
-  const Shape ball(Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "ball");
+  const Shape ball(
+    Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "ball");
   Hypervolume hv(ball);
   Attribute density;
   density.name = "density";

@@ -81,5 +81,5 @@ TEST(Expr, SubtreeReplacement)
   EXPECT_TRUE(edited.child(1).identical(box));
   EXPECT_DOUBLE_EQ(evaluateReference(model, { 0.8, 0, 0, 0 }), 0.36);
   EXPECT_DOUBLE_EQ(evaluateReference(edited, { 0.8, 0, 0, 0 }), -0.3); // box wins: 0.5 - 0.8
-  EXPECT_TRUE(model.replace(Expr::z(), x).identical(model)); // nothing to replace
+  EXPECT_TRUE(model.replace(Expr::z(), x).identical(model));           // nothing to replace
 }

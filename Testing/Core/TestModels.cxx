@@ -133,15 +133,16 @@ void expectOutsideOnBounds(const ModelInfo& info, double t = 0)
         {
           continue; // a 2D model has no z faces
         }
-        EXPECT_LT(e.eval(p[0], p[1], p[2], t), 0) << info.name << " at " << p[0] << ", " << p[1]
-                                                   << ", " << p[2] << ", t = " << t;
+        EXPECT_LT(e.eval(p[0], p[1], p[2], t), 0)
+          << info.name << " at " << p[0] << ", " << p[1] << ", " << p[2] << ", t = " << t;
       }
     }
   }
 }
 } // namespace
 
-// --- registry -------------------------------------------------------------------------------------
+// --- registry
+// -------------------------------------------------------------------------------------
 
 TEST(ModelRegistry, BundledModelsAreRegisteredOnce)
 {
@@ -149,7 +150,8 @@ TEST(ModelRegistry, BundledModelsAreRegisteredOnce)
   const std::vector<std::string> before = modelNames();
   registerBundledModels(); // idempotent
   EXPECT_EQ(modelNames(), before);
-  for (const char* name : { "sphere", "csg3", "blend100", "random1000", "walnut", "disk2d", "morph" })
+  for (const char* name :
+    { "sphere", "csg3", "blend100", "random1000", "walnut", "disk2d", "morph" })
   {
     EXPECT_NE(std::find(before.begin(), before.end(), name), before.end()) << name;
     const ModelInfo& info = findModel(name);
@@ -184,7 +186,10 @@ TEST(ModelRegistry, RegisterRejectsDuplicatesAndBadInfo)
   info.name = "sphere";
   info.boundsLo = { -1, -1, -1 };
   info.boundsHi = { 1, 1, 1 };
-  info.build = [] { return Hypervolume(Shape(Expr(1.0), Domain::XYZ)); };
+  info.build = []
+  {
+    return Hypervolume(Shape(Expr(1.0), Domain::XYZ));
+  };
   EXPECT_THROW(registerModel(info), std::invalid_argument);
   info.name = "";
   EXPECT_THROW(registerModel(info), std::invalid_argument);
@@ -192,7 +197,10 @@ TEST(ModelRegistry, RegisterRejectsDuplicatesAndBadInfo)
   info.build = nullptr;
   EXPECT_THROW(registerModel(info), std::invalid_argument);
   info.name = "test-bad-bounds";
-  info.build = [] { return Hypervolume(Shape(Expr(1.0), Domain::XYZ)); };
+  info.build = []
+  {
+    return Hypervolume(Shape(Expr(1.0), Domain::XYZ));
+  };
   info.boundsHi = { 1, -2, 1 };
   EXPECT_THROW(registerModel(info), std::invalid_argument);
 
@@ -221,7 +229,10 @@ TEST(ModelRegistry, ConcurrentRegistrationAndLookup)
             info.name = "concurrent-" + std::to_string(k) + "-" + std::to_string(i);
             info.boundsLo = { 0, 0, 0 };
             info.boundsHi = { 1, 1, 1 };
-            info.build = [] { return Hypervolume(Shape(Expr(1.0), Domain::XYZ)); };
+            info.build = []
+            {
+              return Hypervolume(Shape(Expr(1.0), Domain::XYZ));
+            };
             registerModel(info);
             if (findModel(info.name).name != info.name || findModel("csg3").name != "csg3")
             {
@@ -257,7 +268,8 @@ TEST(BundledModels, BoundsContainEveryModel)
   }
 }
 
-// --- sphere and csg3 ------------------------------------------------------------------------------
+// --- sphere and csg3
+// ------------------------------------------------------------------------------
 
 TEST(BundledModels, Sphere)
 {
@@ -274,7 +286,10 @@ TEST(BundledModels, Sphere)
 TEST(BundledModels, VtkBoxField)
 {
   const Expr box = bundled::vtkBoxField({ -0.8, -0.8, -0.8 }, { 0.8, 0.8, 0.8 });
-  auto at = [&](double x, double y, double z) { return evaluateReference(box, { x, y, z, 0 }); };
+  auto at = [&](double x, double y, double z)
+  {
+    return evaluateReference(box, { x, y, z, 0 });
+  };
   EXPECT_DOUBLE_EQ(at(0, 0, 0), 0.8);
   EXPECT_NEAR(at(0.7, 0, 0), 0.1, 1e-15);
   EXPECT_NEAR(at(0.7, -0.75, 0.2), 0.05, 1e-15);
@@ -298,20 +313,21 @@ TEST(BundledModels, Csg3)
 {
   const Hypervolume hv = build("csg3");
   // Sphere r = 1, box [-0.8, 0.8]^3, cylinder along y with r = 0.4 removed.
-  EXPECT_NEAR(value(hv, 0, 0, 0), -0.16, 1e-15);       // in the hole: -(0.16 - 0)
-  EXPECT_NEAR(value(hv, 0, 0.7, 0), -0.16, 1e-15);     // the hole goes through along y
-  EXPECT_NEAR(value(hv, 0.6, 0, 0), 0.2, 1e-15);       // box face 0.2, cylinder 0.2, sphere 0.64
-  EXPECT_NEAR(value(hv, 0, 0.5, 0.5), 0.09, 1e-15);    // cylinder: 0.25 - 0.16
+  EXPECT_NEAR(value(hv, 0, 0, 0), -0.16, 1e-15);        // in the hole: -(0.16 - 0)
+  EXPECT_NEAR(value(hv, 0, 0.7, 0), -0.16, 1e-15);      // the hole goes through along y
+  EXPECT_NEAR(value(hv, 0.6, 0, 0), 0.2, 1e-15);        // box face 0.2, cylinder 0.2, sphere 0.64
+  EXPECT_NEAR(value(hv, 0, 0.5, 0.5), 0.09, 1e-15);     // cylinder: 0.25 - 0.16
   EXPECT_NEAR(value(hv, 0.75, 0.75, 0), -0.125, 1e-15); // outside the sphere only
-  EXPECT_NEAR(value(hv, 0.5, 0.85, 0), -0.05, 1e-15);  // outside the box only
-  EXPECT_NEAR(value(hv, 1.5, 0, 0), -1.25, 1e-15);     // outside all: the sphere is lowest
-  EXPECT_LT(value(hv, 0.3, 0.2, 0.1), 0);              // inside the cylinder
+  EXPECT_NEAR(value(hv, 0.5, 0.85, 0), -0.05, 1e-15);   // outside the box only
+  EXPECT_NEAR(value(hv, 1.5, 0, 0), -1.25, 1e-15);      // outside all: the sphere is lowest
+  EXPECT_LT(value(hv, 0.3, 0.2, 0.1), 0);               // inside the cylinder
   EXPECT_GT(value(hv, 0.5, 0.2, 0.3), 0);
   // The cylinder is the only place where VTK rounds differently (its projection on the axis).
   expectMinusVtk(bundled::csg3Recipe(), 1e-15);
 }
 
-// --- random1000 -------------------------------------------------------------------------------------
+// --- random1000
+// -------------------------------------------------------------------------------------
 
 TEST(BundledModels, Random1000)
 {
@@ -340,7 +356,8 @@ TEST(BundledModels, Random1000)
   // (Values recorded from the implementation; a change here changes the benchmark model.)
   const CsgNode& first = r.nodes[0];
   EXPECT_EQ(first.kind, CsgNode::Kind::Sphere);
-  const std::array<double, 6> expected{ 0.0185546875, -0.1708984375, 0.1552734375, 0.2119140625, 0, 0 };
+  const std::array<double, 6> expected{ 0.0185546875, -0.1708984375, 0.1552734375, 0.2119140625, 0,
+    0 };
   EXPECT_EQ(first.p, expected);
 
   expectMinusVtk(r, 0.0);
@@ -363,7 +380,8 @@ TEST(BundledModels, Random1000)
   EXPECT_LT(inside, total / 2);
 }
 
-// --- blend100 ---------------------------------------------------------------------------------------
+// --- blend100
+// ---------------------------------------------------------------------------------------
 
 TEST(BundledModels, Blend100)
 {
@@ -371,17 +389,18 @@ TEST(BundledModels, Blend100)
   const std::size_t nodes = hv.geometry().function().nodeCount();
   EXPECT_GE(nodes, 80u);
   EXPECT_LE(nodes, 130u);
-  EXPECT_GT(value(hv, 0, 0, 0), 0);        // the body
-  EXPECT_GT(value(hv, 0.85, 0, 0), 0);     // the lobe along +x
-  EXPECT_GT(value(hv, -0.6, 0.7, 0), 0);   // the lobe towards -x +y
-  EXPECT_GT(value(hv, 1.0, 0, 0), 0);      // the tip of the +x lobe, inside the cap
-  EXPECT_LT(value(hv, 0, 0, -0.7), 0);     // no lobe along -z
+  EXPECT_GT(value(hv, 0, 0, 0), 0);      // the body
+  EXPECT_GT(value(hv, 0.85, 0, 0), 0);   // the lobe along +x
+  EXPECT_GT(value(hv, -0.6, 0.7, 0), 0); // the lobe towards -x +y
+  EXPECT_GT(value(hv, 1.0, 0, 0), 0);    // the tip of the +x lobe, inside the cap
+  EXPECT_LT(value(hv, 0, 0, -0.7), 0);   // no lobe along -z
   EXPECT_LT(value(hv, 0, -0.45, 0.65), 0);
-  EXPECT_LT(value(hv, 1.1, 0, 0), 0);      // cut by the cap (x <= 1.05)
+  EXPECT_LT(value(hv, 1.1, 0, 0), 0); // cut by the cap (x <= 1.05)
   EXPECT_TRUE(build("blend100").geometry().function().identical(hv.geometry().function()));
 }
 
-// --- walnut -----------------------------------------------------------------------------------------
+// --- walnut
+// -----------------------------------------------------------------------------------------
 
 TEST(BundledModels, WalnutAttributes)
 {
@@ -397,7 +416,10 @@ TEST(BundledModels, WalnutAttributes)
   double f = 0;
   double a[5];
   const Expr noise = gardnerNoise(0.25, 12.0, 1.4);
-  auto noiseAt = [&](double x, double y, double z) { return evaluateReference(noise, { x, y, z, 0 }); };
+  auto noiseAt = [&](double x, double y, double z)
+  {
+    return evaluateReference(noise, { x, y, z, 0 });
+  };
 
   // In the shell, on the x axis: outer 1 - 0.93^2 (+ noise), inner -(1 - (0.93/0.85)^2).
   e.eval({ 0.93, 0, 0, 0 }, f, a);
@@ -405,9 +427,9 @@ TEST(BundledModels, WalnutAttributes)
   const double inner = 1 - (0.93 / 0.85) * (0.93 / 0.85);
   EXPECT_NEAR(f, std::min(outer, -inner), 1e-12);
   EXPECT_GT(f, 0);
-  EXPECT_EQ(a[0], 1.0);                    // material: shell
+  EXPECT_EQ(a[0], 1.0);                       // material: shell
   EXPECT_NEAR(a[1], 1.2 - 0.4 * 0.93, 1e-12); // density graded with the radius
-  EXPECT_EQ(a[2], 0.55);                   // colour: shell brown
+  EXPECT_EQ(a[2], 0.55);                      // colour: shell brown
   EXPECT_EQ(a[3], 0.36);
   EXPECT_EQ(a[4], 0.2);
   EXPECT_EQ(e.membership({ 0.93, 0, 0, 0 }), 2);
@@ -448,7 +470,8 @@ TEST(BundledModels, WalnutAttributes)
   EXPECT_NE(noiseAt(0.5, 0.4, 0.3), 0.0);
 }
 
-// --- 2D and space-time ------------------------------------------------------------------------------
+// --- 2D and space-time
+// ------------------------------------------------------------------------------
 
 TEST(BundledModels, Disk2D)
 {

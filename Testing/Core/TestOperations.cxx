@@ -33,14 +33,14 @@ const Shape probe3(Expr::z(), Domain::XYZ, "f3");
 
 Shape unitSphere()
 {
-  return Shape(Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ,
-    "sphere");
+  return Shape(
+    Expr(1.0) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "sphere");
 }
 
 Shape sphere(double r)
 {
-  return Shape(Expr(r * r) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ,
-    "sphere");
+  return Shape(
+    Expr(r * r) - square(Expr::x()) - square(Expr::y()) - square(Expr::z()), Domain::XYZ, "sphere");
 }
 
 Shape disk(double cx, double cy, double r)
@@ -64,7 +64,8 @@ double testField(double x, double y, double z)
 Shape testShape()
 {
   const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
-  return Shape(1.0 - square(x - 0.3) - 2.0 * square(y + 0.2) - 0.5 * square(z) + 0.7 * x * y - 0.4 * z,
+  return Shape(
+    1.0 - square(x - 0.3) - 2.0 * square(y + 0.2) - 0.5 * square(z) + 0.7 * x * y - 0.4 * z,
     Domain::XYZ, "field");
 }
 
@@ -73,7 +74,8 @@ const double samples[] = { -7.5, -3.0, -1.0, -0.25, 0.0, 0.3, 1.0, 2.0, 4.0, 11.
 
 // Expects `op` to throw E whose message contains every string in `parts`.
 template <typename E>
-void expectThrowMentioning(const std::function<void()>& op, std::initializer_list<const char*> parts)
+void expectThrowMentioning(
+  const std::function<void()>& op, std::initializer_list<const char*> parts)
 {
   try
   {
@@ -146,7 +148,8 @@ TEST(Operations, AlphaSystemMatchesFormulaOnSamples)
       for (double f2 : samples)
       {
         const double scaleTol = tol * (1.0 + std::fabs(f1) + std::fabs(f2));
-        EXPECT_NEAR(eval(u, f1, f2), refUnion(f1, f2, alpha), scaleTol) << alpha << " " << f1 << " " << f2;
+        EXPECT_NEAR(eval(u, f1, f2), refUnion(f1, f2, alpha), scaleTol)
+          << alpha << " " << f1 << " " << f2;
         EXPECT_NEAR(eval(i, f1, f2), refIntersection(f1, f2, alpha), scaleTol);
         EXPECT_NEAR(eval(d, f1, f2), refIntersection(f1, -f2, alpha), scaleTol);
       }
@@ -173,7 +176,10 @@ TEST(Operations, RFunctionSignAgreesWithMinMax)
   {
     for (double f2 : samples)
     {
-      const auto sgn = [](double v) { return (v > 0) - (v < 0); };
+      const auto sgn = [](double v)
+      {
+        return (v > 0) - (v < 0);
+      };
       EXPECT_EQ(sgn(eval(u, f1, f2)), sgn(std::max(f1, f2))) << f1 << " " << f2;
       EXPECT_EQ(sgn(eval(i, f1, f2)), sgn(std::min(f1, f2))) << f1 << " " << f2;
     }
@@ -182,8 +188,10 @@ TEST(Operations, RFunctionSignAgreesWithMinMax)
 
 TEST(Operations, AlphaOutOfRangeIsRejected)
 {
-  expectThrowMentioning<std::invalid_argument>([] { unite(probe1, probe2, -1.0); }, { "unite", "alpha" });
-  expectThrowMentioning<std::invalid_argument>([] { intersect(probe1, probe2, 1.5); }, { "intersect", "alpha" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { unite(probe1, probe2, -1.0); }, { "unite", "alpha" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { intersect(probe1, probe2, 1.5); }, { "intersect", "alpha" });
   expectThrowMentioning<std::invalid_argument>(
     [] { subtract(probe1, probe2, std::nan("")); }, { "subtract", "alpha" });
 }
@@ -222,8 +230,8 @@ TEST(Operations, UnionOfSeparateDisks)
 
 TEST(Operations, CmRFunctions)
 {
-  // Pasko & Savchenko: (f1 + f2 +- sqrt(f1^2 + f2^2)) (f1^2 + f2^2)^(m/2). At (3, 4), f1^2 + f2^2 = 25:
-  // union m = 1: 12 * 5 = 60; m = 2: 12 * 25 = 300; intersection m = 2: 2 * 25 = 50;
+  // Pasko & Savchenko: (f1 + f2 +- sqrt(f1^2 + f2^2)) (f1^2 + f2^2)^(m/2). At (3, 4), f1^2 + f2^2 =
+  // 25: union m = 1: 12 * 5 = 60; m = 2: 12 * 25 = 300; intersection m = 2: 2 * 25 = 50;
   // subtraction m = 1 (f2 -> -4): (3 - 4 - 5) * 5 = -30.
   EXPECT_NEAR(eval(uniteCm(probe1, probe2, 1), 3, 4), 60.0, tol);
   EXPECT_NEAR(eval(uniteCm(probe1, probe2, 2), 3, 4), 300.0, tol);
@@ -235,8 +243,8 @@ TEST(Operations, CmRFunctions)
     {
       EXPECT_NEAR(eval(uniteCm(probe1, probe2, 0), f1, f2), refUnion(f1, f2, 0.0), tol * 100);
       const double s = f1 * f1 + f2 * f2;
-      EXPECT_NEAR(eval(intersectCm(probe1, probe2, 3), f1, f2), refIntersection(f1, f2, 0.0) * s * std::sqrt(s),
-        1e-12 * (1.0 + s * s));
+      EXPECT_NEAR(eval(intersectCm(probe1, probe2, 3), f1, f2),
+        refIntersection(f1, f2, 0.0) * s * std::sqrt(s), 1e-12 * (1.0 + s * s));
     }
   }
   EXPECT_THROW(uniteCm(probe1, probe2, -1), std::invalid_argument);
@@ -246,7 +254,8 @@ TEST(Operations, CmRFunctions)
 
 TEST(Operations, BlendUnionThesisValues)
 {
-  // Spec items 17-18 (L643-L645): F_b(0, 0) = 0 + 1/(1 + 0 + 0) = 1; F_b(3, 4) = 12 + 1/(1 + 9 + 16).
+  // Spec items 17-18 (L643-L645): F_b(0, 0) = 0 + 1/(1 + 0 + 0) = 1; F_b(3, 4) = 12 + 1/(1 + 9 +
+  // 16).
   const Shape b = blendUnion(probe1, probe2, 1, 1, 1);
   EXPECT_NEAR(eval(b, 0, 0), 1.0, tol);
   EXPECT_NEAR(eval(b, 3, 4), 12.0 + 1.0 / 26.0, tol);
@@ -314,7 +323,8 @@ TEST(Operations, BlendParameterValidation)
     [] { blendUnion(probe1, probe2, INFINITY, 1, 1); }, { "blendUnion", "a0" });
   expectThrowMentioning<std::invalid_argument>(
     [] { boundedBlend(probe1, probe2, probe3, 1, 1, 0); }, { "boundedBlend", "a3" });
-  expectThrowMentioning<std::invalid_argument>([] { offset(probe1, std::nan("")); }, { "offset", "d" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { offset(probe1, std::nan("")); }, { "offset", "d" });
 }
 
 TEST(Operations, BoundedBlendThesisValues)
@@ -343,7 +353,8 @@ TEST(Operations, BoundedBlendMatchesFormulaOnSamples)
       for (double f3 : samples)
       {
         const double v = eval(bb, f1, f2, f3);
-        EXPECT_NEAR(v, refBoundedBlend(f1, f2, f3, a0, a1, a2, a3), tol * (1 + std::fabs(f1) + std::fabs(f2)))
+        EXPECT_NEAR(
+          v, refBoundedBlend(f1, f2, f3, a0, a1, a2, a3), tol * (1 + std::fabs(f1) + std::fabs(f2)))
           << f1 << " " << f2 << " " << f3;
         // Item 25: outside the bounding solid the result is the R-union exactly.
         if (f3 <= 0)
@@ -392,17 +403,21 @@ TEST(Operations, MixedDomainsAreRejected)
   expectThrowMentioning<DomainError>([&] { subtractMinMax(c, b); }, { "circle", "block" });
   expectThrowMentioning<DomainError>([&] { uniteCm(c, b, 1); }, { "circle", "block" });
   expectThrowMentioning<DomainError>([&] { blendUnion(c, b, 1, 1, 1); }, { "circle", "block" });
-  expectThrowMentioning<DomainError>([&] { blendIntersection(c, b, 1, 1, 1); }, { "circle", "block" });
-  expectThrowMentioning<DomainError>([&] { boundedBlend(b, b, c, 1, 1, 1); }, { "circle", "block" });
+  expectThrowMentioning<DomainError>(
+    [&] { blendIntersection(c, b, 1, 1, 1); }, { "circle", "block" });
+  expectThrowMentioning<DomainError>(
+    [&] { boundedBlend(b, b, c, 1, 1, 1); }, { "circle", "block" });
   expectThrowMentioning<DomainError>([&] { metamorphosis(c, b, 0.5); }, { "circle", "block" });
-  expectThrowMentioning<DomainError>([&] { spaceTimeBlend(c, b, 0, 1, 1, 1, 1, 1); }, { "circle", "block" });
+  expectThrowMentioning<DomainError>(
+    [&] { spaceTimeBlend(c, b, 0, 1, 1, 1, 1, 1); }, { "circle", "block" });
 }
 
 // --- space mappings ----------------------------------------------------------------------------
 
 TEST(Operations, ShiftAndScale)
 {
-  // hfShift3D: f'(p) = f(p - v). The unit sphere shifted by (1, 2, 3) has its centre (value 1) there.
+  // hfShift3D: f'(p) = f(p - v). The unit sphere shifted by (1, 2, 3) has its centre (value 1)
+  // there.
   const Shape s = shift(unitSphere(), { 1, 2, 3 });
   EXPECT_NEAR(eval(s, 1, 2, 3), 1.0, tol);
   EXPECT_NEAR(eval(s, 2, 2, 3), 0.0, tol);
@@ -428,8 +443,16 @@ TEST(Operations, ShiftAndScale)
   EXPECT_NEAR(eval(shift(disk(0, 0, 1), { 1, 0, 0 }), 1, 0), 1.0, tol);
   expectThrowMentioning<DomainError>([] { shift(disk(0, 0, 1), { 0, 0, 1 }); }, { "shift", "z" });
   expectThrowMentioning<DomainError>([] { scale(disk(0, 0, 1), { 1, 1, 2 }); }, { "scale", "z" });
-  expectThrowMentioning<std::invalid_argument>([] { scale(unitSphere(), { 1, 0, 1 }); }, { "scale", "s" });
-  expectThrowMentioning<std::invalid_argument>([] { shift(unitSphere(), { NAN, 0, 1 }); }, { "shift", "v" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] {
+      scale(unitSphere(), { 1, 0, 1 });
+    },
+    { "scale", "s" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] {
+      shift(unitSphere(), { NAN, 0, 1 });
+    },
+    { "shift", "v" });
 }
 
 TEST(Operations, RotateFollowsHyperFunConvention)
@@ -453,16 +476,21 @@ TEST(Operations, RotateFollowsHyperFunConvention)
     {
       for (double z : { -0.9, 0.6 })
       {
-        EXPECT_NEAR(eval(rotate(f, Axis::Z, th), x, y, z), testField(x * c + y * s, -x * s + y * c, z), tol);
-        EXPECT_NEAR(eval(rotate(f, Axis::X, th), x, y, z), testField(x, y * c + z * s, -y * s + z * c), tol);
-        EXPECT_NEAR(eval(rotate(f, Axis::Y, th), x, y, z), testField(-z * s + x * c, y, z * c + x * s), tol);
+        EXPECT_NEAR(
+          eval(rotate(f, Axis::Z, th), x, y, z), testField(x * c + y * s, -x * s + y * c, z), tol);
+        EXPECT_NEAR(
+          eval(rotate(f, Axis::X, th), x, y, z), testField(x, y * c + z * s, -y * s + z * c), tol);
+        EXPECT_NEAR(
+          eval(rotate(f, Axis::Y, th), x, y, z), testField(-z * s + x * c, y, z * c + x * s), tol);
       }
     }
   }
   // A disk rotates in its own plane; about x it would need z.
   EXPECT_NEAR(eval(rotate(disk(2, 0, 1), Axis::Z, pi / 2), 0, 2), 1.0, tol);
-  expectThrowMentioning<DomainError>([] { rotate(disk(0, 0, 1), Axis::X, 1.0); }, { "rotate", "z" });
-  expectThrowMentioning<std::invalid_argument>([] { rotate(unitSphere(), Axis::T, 1.0); }, { "rotate", "axis" });
+  expectThrowMentioning<DomainError>(
+    [] { rotate(disk(0, 0, 1), Axis::X, 1.0); }, { "rotate", "z" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { rotate(unitSphere(), Axis::T, 1.0); }, { "rotate", "axis" });
   expectThrowMentioning<std::invalid_argument>(
     [] { rotate(unitSphere(), Axis::Z, INFINITY); }, { "rotate", "angleRadians" });
 }
@@ -471,7 +499,7 @@ TEST(Operations, AffineInverseMapsTheQueryPoint)
 {
   // p' = A p + b; the mapped shape at A p + b equals the original at p.
   const std::array<double, 12> m = { 2.0, 0.5, 0.0, 1.0, //
-    -0.3, 1.5, 0.2, -2.0,                                   //
+    -0.3, 1.5, 0.2, -2.0,                                //
     0.1, 0.0, 0.8, 0.5 };
   const Shape f = testShape();
   const Shape g = affine(f, m);
@@ -495,14 +523,26 @@ TEST(Operations, AffineInverseMapsTheQueryPoint)
   const Shape d = affine(disk(0, 0, 1), { 0, -1, 0, 3, 1, 0, 0, 0, 0, 0, 1, 0 });
   EXPECT_NEAR(eval(d, 3, 0), 1.0, tol);
   expectThrowMentioning<DomainError>(
-    [] { affine(disk(0, 0, 1), { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1 }); }, { "affine", "z" });
+    [] {
+      affine(disk(0, 0, 1), { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1 });
+    },
+    { "affine", "z" });
   expectThrowMentioning<DomainError>(
-    [] { affine(disk(0, 0, 1), { 1, 0, 1, 0, 0, 1, 0, 0, 0, 0, 1, 0 }); }, { "affine", "z" });
+    [] {
+      affine(disk(0, 0, 1), { 1, 0, 1, 0, 0, 1, 0, 0, 0, 0, 1, 0 });
+    },
+    { "affine", "z" });
   // Singular: the third row is the sum of the first two.
   expectThrowMentioning<std::invalid_argument>(
-    [] { affine(unitSphere(), { 1, 2, 3, 0, 0, 1, 1, 0, 1, 3, 4, 0 }); }, { "affine", "matrix", "singular" });
+    [] {
+      affine(unitSphere(), { 1, 2, 3, 0, 0, 1, 1, 0, 1, 3, 4, 0 });
+    },
+    { "affine", "matrix", "singular" });
   expectThrowMentioning<std::invalid_argument>(
-    [] { affine(unitSphere(), { 1, 0, 0, 0, 0, NAN, 0, 0, 0, 0, 1, 0 }); }, { "affine", "matrix" });
+    [] {
+      affine(unitSphere(), { 1, 0, 0, 0, 0, NAN, 0, 0, 0, 0, 1, 0 });
+    },
+    { "affine", "matrix" });
 }
 
 TEST(Operations, TwistFollowsHfTwist)
@@ -547,8 +587,10 @@ TEST(Operations, TwistFollowsHfTwist)
       }
     }
   }
-  expectThrowMentioning<std::invalid_argument>([] { twist(unitSphere(), Axis::Z, 1, 1, 0, 1); }, { "twist", "z1" });
-  expectThrowMentioning<DomainError>([] { twist(disk(0, 0, 1), Axis::Z, 0, 1, 0, 1); }, { "twist", "z" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { twist(unitSphere(), Axis::Z, 1, 1, 0, 1); }, { "twist", "z1" });
+  expectThrowMentioning<DomainError>(
+    [] { twist(disk(0, 0, 1), Axis::Z, 0, 1, 0, 1); }, { "twist", "z" });
 }
 
 TEST(Operations, TaperFollowsHfTaper)
@@ -571,10 +613,14 @@ TEST(Operations, TaperFollowsHfTaper)
     const double sc = (1 - t) * 0.5 + t * 3;
     EXPECT_NEAR(eval(tx, x, 0.7, -0.4), testField(x, 0.7 / sc, -0.4 / sc), tol);
   }
-  expectThrowMentioning<std::invalid_argument>([&] { taper(cyl, Axis::Z, 0, 1, 0, 2); }, { "taper", "s1" });
-  expectThrowMentioning<std::invalid_argument>([&] { taper(cyl, Axis::Z, 0, 1, 1, -2); }, { "taper", "s2" });
-  expectThrowMentioning<std::invalid_argument>([&] { taper(cyl, Axis::Z, 1, 0, 1, 2); }, { "taper", "z1" });
-  expectThrowMentioning<DomainError>([] { taper(disk(0, 0, 1), Axis::Z, 0, 1, 1, 2); }, { "taper" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { taper(cyl, Axis::Z, 0, 1, 0, 2); }, { "taper", "s1" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { taper(cyl, Axis::Z, 0, 1, 1, -2); }, { "taper", "s2" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { taper(cyl, Axis::Z, 1, 0, 1, 2); }, { "taper", "z1" });
+  expectThrowMentioning<DomainError>(
+    [] { taper(disk(0, 0, 1), Axis::Z, 0, 1, 1, 2); }, { "taper" });
 }
 
 TEST(Operations, BendWrapsTheLengthAxisOntoACircle)
@@ -598,7 +644,8 @@ TEST(Operations, BendWrapsTheLengthAxisOntoACircle)
         }
         const double U = -std::sin(k * u) * (v - R), V = std::cos(k * u) * (v - R) + R;
         // About x: (y, z) plane; about y: (z, x); about z: (x, y).
-        EXPECT_NEAR(eval(bend(f, Axis::X, k), 0.4, U, V), testField(0.4, u, v), 1e-12) << k << " " << u << " " << v;
+        EXPECT_NEAR(eval(bend(f, Axis::X, k), 0.4, U, V), testField(0.4, u, v), 1e-12)
+          << k << " " << u << " " << v;
         EXPECT_NEAR(eval(bend(f, Axis::Y, k), V, 0.4, U), testField(v, 0.4, u), 1e-12);
         EXPECT_NEAR(eval(bend(f, Axis::Z, k), U, V, 0.4), testField(u, v, 0.4), 1e-12);
       }
@@ -608,7 +655,8 @@ TEST(Operations, BendWrapsTheLengthAxisOntoACircle)
   // A disk bends in its plane (about z) but not about x.
   EXPECT_NO_THROW(bend(disk(0, 0, 1), Axis::Z, 0.5));
   expectThrowMentioning<DomainError>([] { bend(disk(0, 0, 1), Axis::X, 0.5); }, { "bend", "z" });
-  expectThrowMentioning<std::invalid_argument>([&] { bend(f, Axis::X, NAN); }, { "bend", "curvature" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { bend(f, Axis::X, NAN); }, { "bend", "curvature" });
 }
 
 TEST(Operations, StretchFollowsHfStretch)
@@ -621,8 +669,15 @@ TEST(Operations, StretchFollowsHfStretch)
   const Shape g = stretch(testShape(), { 0.5, -1, 2 }, { 3, 0.5, -2 });
   EXPECT_NEAR(eval(g, 1, 1, 1), testField(0.5 + 0.5 / 3, -1 + 2 / 0.5, 2 + (-1) / -2.0), tol);
   expectThrowMentioning<std::invalid_argument>(
-    [] { stretch(unitSphere(), { 0, 0, 0 }, { 1, 0, 1 }); }, { "stretch", "factors" });
-  expectThrowMentioning<DomainError>([] { stretch(disk(0, 0, 1), { 0, 0, 0 }, { 1, 1, 3 }); }, { "stretch", "z" });
+    [] {
+      stretch(unitSphere(), { 0, 0, 0 }, { 1, 0, 1 });
+    },
+    { "stretch", "factors" });
+  expectThrowMentioning<DomainError>(
+    [] {
+      stretch(disk(0, 0, 1), { 0, 0, 0 }, { 1, 1, 3 });
+    },
+    { "stretch", "z" });
 }
 
 // --- dimension and time ------------------------------------------------------------------------
@@ -647,8 +702,10 @@ TEST(Operations, CartesianProductOfDiskAndTimeInterval)
   }
   const Shape seg((Expr::x() + 1.0) * (1.0 - Expr::x()), Domain::X, "segment");
   EXPECT_EQ(cartesianProduct(seg, ti).domain(), Domain::XT);
-  expectThrowMentioning<DomainError>([&] { cartesianProduct(d, seg); }, { "cartesianProduct", "circle", "segment" });
-  expectThrowMentioning<DomainError>([&] { cartesianProduct(d, unitSphere()); }, { "cartesianProduct" });
+  expectThrowMentioning<DomainError>(
+    [&] { cartesianProduct(d, seg); }, { "cartesianProduct", "circle", "segment" });
+  expectThrowMentioning<DomainError>(
+    [&] { cartesianProduct(d, unitSphere()); }, { "cartesianProduct" });
 }
 
 TEST(Operations, CartesianProductWithPlacementThesisExample)
@@ -666,9 +723,14 @@ TEST(Operations, CartesianProductWithPlacementThesisExample)
   EXPECT_NEAR(eval(c, 0.5, 1, 0.5), refRi(0.5, 3.0), tol);
   // x, z and t do not form a domain.
   expectThrowMentioning<DomainError>(
-    [&] { cartesianProduct(d, { Axis::X, Axis::Z }, Shape(Expr::t(), Domain::T, "ti"), { Axis::T }); },
+    [&] {
+      cartesianProduct(d, { Axis::X, Axis::Z }, Shape(Expr::t(), Domain::T, "ti"), { Axis::T });
+    },
     { "cartesianProduct" });
-  expectThrowMentioning<DomainError>([&] { cartesianProduct(d, { Axis::X, Axis::Y }, seg, { Axis::Y }); },
+  expectThrowMentioning<DomainError>(
+    [&] {
+      cartesianProduct(d, { Axis::X, Axis::Y }, seg, { Axis::Y });
+    },
     { "cartesianProduct" });
 }
 
@@ -689,14 +751,19 @@ TEST(Operations, ProjectionIsASampledMaximum)
     EXPECT_LE(eval(coarse, x, 0.1), 1.0 - x * x - 0.01 + 1e-15);
   }
   // XYZT -> XYZ by dropping t.
-  const Shape moving(1.0 - square(Expr::x() - Expr::t()) - square(Expr::y()) - square(Expr::z()), Domain::XYZT, "moving");
+  const Shape moving(1.0 - square(Expr::x() - Expr::t()) - square(Expr::y()) - square(Expr::z()),
+    Domain::XYZT, "moving");
   const Shape swept = project(moving, Axis::T, 0, 3, 31);
   EXPECT_EQ(swept.domain(), Domain::XYZ);
   EXPECT_NEAR(eval(swept, 2, 0, 0), 1.0, tol); // t = 2 is sample 20
-  expectThrowMentioning<DomainError>([] { project(unitSphere(), Axis::Y, -1, 1); }, { "project", "y" });
-  expectThrowMentioning<DomainError>([] { project(disk(0, 0, 1), Axis::T, -1, 1); }, { "project", "t" });
-  expectThrowMentioning<std::invalid_argument>([] { project(unitSphere(), Axis::Z, -1, 1, 1); }, { "project", "samples" });
-  expectThrowMentioning<std::invalid_argument>([] { project(unitSphere(), Axis::Z, 1, 1); }, { "project", "lo" });
+  expectThrowMentioning<DomainError>(
+    [] { project(unitSphere(), Axis::Y, -1, 1); }, { "project", "y" });
+  expectThrowMentioning<DomainError>(
+    [] { project(disk(0, 0, 1), Axis::T, -1, 1); }, { "project", "t" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { project(unitSphere(), Axis::Z, -1, 1, 1); }, { "project", "samples" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { project(unitSphere(), Axis::Z, 1, 1); }, { "project", "lo" });
 }
 
 TEST(Operations, Metamorphosis)
@@ -707,19 +774,24 @@ TEST(Operations, Metamorphosis)
   {
     for (double f1 : samples)
     {
-      EXPECT_NEAR(eval(metamorphosis(probe1, probe2, s), f1, 2.0), (1 - s) * f1 + s * 2.0, tol * 10);
+      EXPECT_NEAR(
+        eval(metamorphosis(probe1, probe2, s), f1, 2.0), (1 - s) * f1 + s * 2.0, tol * 10);
     }
   }
-  expectThrowMentioning<std::invalid_argument>([] { metamorphosis(probe1, probe2, 1.5); }, { "metamorphosis", "s" });
-  expectThrowMentioning<std::invalid_argument>([] { metamorphosis(probe1, probe2, NAN); }, { "metamorphosis", "s" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { metamorphosis(probe1, probe2, 1.5); }, { "metamorphosis", "s" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { metamorphosis(probe1, probe2, NAN); }, { "metamorphosis", "s" });
   // Over time: s = clamp((t - 1)/2, 0, 1); the disks of radius 1 and 2 -> XYT.
   const Shape m = metamorphosis(disk(0, 0, 1), disk(0, 0, 2), 1.0, 3.0);
   EXPECT_EQ(m.domain(), Domain::XYT);
   EXPECT_NEAR(eval(m, 0.5, 0, 0, 0.0), 0.75, tol);
   EXPECT_NEAR(eval(m, 0.5, 0, 0, 2.0), 0.5 * 0.75 + 0.5 * 3.75, tol);
   EXPECT_NEAR(eval(m, 0.5, 0, 0, 9.0), 3.75, tol);
-  expectThrowMentioning<DomainError>([&] { metamorphosis(m, m, 0.0, 1.0); }, { "metamorphosis", "t" });
-  expectThrowMentioning<std::invalid_argument>([] { metamorphosis(probe1, probe2, 2.0, 1.0); }, { "metamorphosis", "t0" });
+  expectThrowMentioning<DomainError>(
+    [&] { metamorphosis(m, m, 0.0, 1.0); }, { "metamorphosis", "t" });
+  expectThrowMentioning<std::invalid_argument>(
+    [] { metamorphosis(probe1, probe2, 2.0, 1.0); }, { "metamorphosis", "t0" });
 }
 
 namespace
@@ -729,7 +801,8 @@ double refStb(double f1, double f2, double t, double t0, double t1, double a0, d
   double a3, double overlap)
 {
   const double tA = t0 + overlap * (t1 - t0), tB = t1 - overlap * (t1 - t0);
-  return refBoundedBlend(refRi(f1, tA - t), refRi(f2, t - tB), refRi(t - t0, t1 - t), a0, a1, a2, a3);
+  return refBoundedBlend(
+    refRi(f1, tA - t), refRi(f2, t - tB), refRi(t - t0, t1 - t), a0, a1, a2, a3);
 }
 } // namespace
 
@@ -741,9 +814,18 @@ TEST(Operations, SpaceTimeBlendOfTwoDisks)
   const double t0 = 0, t1 = 1, a0 = 5, a1 = 5, a2 = 5, a3 = 0.1;
   const Shape stb = spaceTimeBlend(d1, d2, t0, t1, a0, a1, a2, a3);
   EXPECT_EQ(stb.domain(), Domain::XYT);
-  const auto f1 = [](double x, double y) { return 1 - (x + 1.5) * (x + 1.5) - y * y; };
-  const auto f2 = [](double x, double y) { return 1 - (x - 1.5) * (x - 1.5) - y * y; };
-  const auto sgn = [](double v) { return (v > 0) - (v < 0); };
+  const auto f1 = [](double x, double y)
+  {
+    return 1 - (x + 1.5) * (x + 1.5) - y * y;
+  };
+  const auto f2 = [](double x, double y)
+  {
+    return 1 - (x - 1.5) * (x - 1.5) - y * y;
+  };
+  const auto sgn = [](double v)
+  {
+    return (v > 0) - (v < 0);
+  };
   for (double x = -3.0; x <= 3.0; x += 0.25)
   {
     for (double y = -1.25; y <= 1.25; y += 0.25)
@@ -762,7 +844,8 @@ TEST(Operations, SpaceTimeBlendOfTwoDisks)
       // The field matches the construction formula everywhere.
       for (double t : { -0.2, 0.1, 0.3, 0.5, 0.8, 1.2 })
       {
-        EXPECT_NEAR(eval(stb, x, y, 0, t), refStb(f1(x, y), f2(x, y), t, t0, t1, a0, a1, a2, a3, 0.25),
+        EXPECT_NEAR(eval(stb, x, y, 0, t),
+          refStb(f1(x, y), f2(x, y), t, t0, t1, a0, a1, a2, a3, 0.25),
           1e-12 * (1 + std::fabs(f1(x, y)) + std::fabs(f2(x, y))));
       }
     }
@@ -783,9 +866,12 @@ TEST(Operations, SpaceTimeBlendValidation)
 {
   const Shape d1 = disk(-1.5, 0, 1);
   const Shape withT(Expr::t() - square(Expr::x()), Domain::XT, "timed");
-  expectThrowMentioning<DomainError>([&] { spaceTimeBlend(withT, withT, 0, 1, 1, 1, 1, 1); }, { "spaceTimeBlend", "timed" });
-  expectThrowMentioning<std::invalid_argument>([&] { spaceTimeBlend(d1, d1, 1, 1, 1, 1, 1, 1); }, { "spaceTimeBlend", "t0" });
-  expectThrowMentioning<std::invalid_argument>([&] { spaceTimeBlend(d1, d1, 0, 1, 1, 1, 1, 0); }, { "spaceTimeBlend", "a3" });
+  expectThrowMentioning<DomainError>(
+    [&] { spaceTimeBlend(withT, withT, 0, 1, 1, 1, 1, 1); }, { "spaceTimeBlend", "timed" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { spaceTimeBlend(d1, d1, 1, 1, 1, 1, 1, 1); }, { "spaceTimeBlend", "t0" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { spaceTimeBlend(d1, d1, 0, 1, 1, 1, 1, 0); }, { "spaceTimeBlend", "a3" });
   expectThrowMentioning<std::invalid_argument>(
     [&] { spaceTimeBlend(d1, d1, 0, 1, 1, 1, 1, 1, 0.0); }, { "spaceTimeBlend", "overlap" });
   // A 3D pair goes to XYZT.
@@ -820,7 +906,8 @@ TEST(Operations, CompiledEvaluatorsAgreeWithTheReference)
         {
           const double ref = eval(s, x, y, zt, zt);
           EXPECT_NEAR(point.eval(x, y, zt, zt), ref, 1e-12 * (1 + std::fabs(ref))) << s.label();
-          EXPECT_TRUE(range.lo <= ref + 1e-12 && ref - 1e-12 <= range.hi) << s.label() << " " << ref;
+          EXPECT_TRUE(range.lo <= ref + 1e-12 && ref - 1e-12 <= range.hi)
+            << s.label() << " " << ref;
         }
       }
     }

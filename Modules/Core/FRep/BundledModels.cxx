@@ -32,7 +32,8 @@ public:
   {
     const std::uint64_t a = engine_() >> 5;
     const std::uint64_t b = engine_() >> 6;
-    return (static_cast<double>(a) * 67108864.0 + static_cast<double>(b)) * (1.0 / 9007199254740992.0);
+    return (static_cast<double>(a) * 67108864.0 + static_cast<double>(b)) *
+      (1.0 / 9007199254740992.0);
   }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform01(); }
 
@@ -152,7 +153,8 @@ int combine(CsgRecipe& r, PortableRandom& rng, const std::vector<int>& leaves, i
   return addNode(r, operation(kind, a, b));
 }
 
-// --- the other models ------------------------------------------------------------------------------
+// --- the other models
+// ------------------------------------------------------------------------------
 
 Expr ellipsoidField(const Vec3& c, double a, double b, double cc)
 {
@@ -183,7 +185,8 @@ Hypervolume blend100()
   {
     s = blendUnion(s, xyz(ellipsoidField(l.c, l.a, l.b, l.cc), "lobe"), 0.25, 0.6, 0.6);
   }
-  s = blendIntersection(s, xyz(ellipsoidField({ 0.05, 0.0, 0.05 }, 1.0, 0.9, 0.9), "cap"), 0.1, 0.5, 0.5);
+  s = blendIntersection(
+    s, xyz(ellipsoidField({ 0.05, 0.0, 0.05 }, 1.0, 0.9, 0.9), "cap"), 0.1, 0.5, 0.5);
   return Hypervolume(s.withLabel("blend100"));
 }
 
@@ -224,7 +227,8 @@ Hypervolume walnut()
 
   Attribute colour;
   colour.name = "colour";
-  colour.components = { select(shell, 0.55, 0.93), select(shell, 0.36, 0.84), select(shell, 0.2, 0.62) };
+  colour.components = { select(shell, 0.55, 0.93), select(shell, 0.36, 0.84),
+    select(shell, 0.2, 0.62) };
   colour.partition = f;
   colour.insideDefault = { 0.0, 0.0, 0.0 };
   colour.outsideDefault = { 0.0, 0.0, 0.0 };
@@ -235,7 +239,8 @@ Hypervolume walnut()
 Hypervolume disk2d()
 {
   // The thesis' 2D example (L532-L539): a disk of radius 2.
-  return Hypervolume(Shape(Expr(4.0) - square(Expr::x()) - square(Expr::y()), Domain::XY, "disk2d"));
+  return Hypervolume(
+    Shape(Expr(4.0) - square(Expr::x()) - square(Expr::y()), Domain::XY, "disk2d"));
 }
 
 Hypervolume morph()
@@ -329,7 +334,8 @@ CsgRecipe random1000Recipe()
     if (isSphere)
     {
       const double radius = rng.uniform(0.15, 0.35);
-      n = leaf(Kind::Sphere, { quantise(c[0]), quantise(c[1]), quantise(c[2]), quantise(radius), 0, 0 });
+      n = leaf(
+        Kind::Sphere, { quantise(c[0]), quantise(c[1]), quantise(c[2]), quantise(radius), 0, 0 });
     }
     else
     {
@@ -353,7 +359,8 @@ std::vector<ModelInfo> modelInfos()
   models.push_back(info("sphere", "unit sphere at the origin, f = 1 - x^2 - y^2 - z^2", -1.2, 1.2,
     [] { return Hypervolume(Shape(csgField(sphereRecipe()), Domain::XYZ, "sphere")); }));
   models.push_back(info("csg3",
-    "(sphere r=1 intersect box [-0.8,0.8]^3) \\ cylinder along y r=0.4 (min/max); exactly minus the "
+    "(sphere r=1 intersect box [-0.8,0.8]^3) \\ cylinder along y r=0.4 (min/max); exactly minus "
+    "the "
     "vtkImplicitBoolean of vtkSphere, vtkBox, vtkCylinder",
     -1.2, 1.2, [] { return Hypervolume(Shape(csgField(csg3Recipe()), Domain::XYZ, "csg3")); }));
   models.push_back(info("blend100",
@@ -369,7 +376,8 @@ std::vector<ModelInfo> modelInfos()
     "heterogeneous demo: noisy shell and two-lobed kernel; attributes material (1 shell, 2 "
     "kernel, -1 outside), density (graded in the shell), colour (RGB)",
     -1.3, 1.3, walnut));
-  ModelInfo disk = info("disk2d", "2D disk f = 4 - x^2 - y^2 (domain XY, thesis L532-L539)", -2.4, 2.4, disk2d);
+  ModelInfo disk =
+    info("disk2d", "2D disk f = 4 - x^2 - y^2 (domain XY, thesis L532-L539)", -2.4, 2.4, disk2d);
   disk.boundsLo[2] = 0;
   disk.boundsHi[2] = 0;
   models.push_back(std::move(disk));

@@ -142,8 +142,8 @@ void requireAxes(const char* operation, const Shape& s, std::uint8_t axes)
   const std::uint8_t missing = static_cast<std::uint8_t>(axes & ~domainAxes(s.domain()));
   if (missing)
   {
-    throw DomainError(std::string(operation) + ": " + s.describe() +
-      " has no coordinate(s) " + axesString(missing));
+    throw DomainError(std::string(operation) + ": " + s.describe() + " has no coordinate(s) " +
+      axesString(missing));
   }
 }
 

@@ -43,8 +43,8 @@ PointEvaluator::PointEvaluator(TapePtr tape, const std::vector<double>& paramete
   : tape_(std::move(tape))
   , slots_(tape_->slotCount(), 0.0)
 {
-  std::copy(tape_->constants().begin(), tape_->constants().end(),
-    slots_.begin() + tape_->constantBase());
+  std::copy(
+    tape_->constants().begin(), tape_->constants().end(), slots_.begin() + tape_->constantBase());
   setParameters(parameters);
 }
 
@@ -129,7 +129,8 @@ __attribute__((always_inline)) inline void runChunkImpl(
 
 // The kernels are compiled for several instruction sets and picked at load time (GCC function
 // multi-versioning), so one portable binary uses AVX2/AVX-512 where the CPU has them.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__) &&                             \
+  !defined(__SANITIZE_ADDRESS__)
 #define ICTK_TARGET_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define ICTK_TARGET_CLONES
@@ -199,7 +200,9 @@ void BatchEvaluator<T>::prepare()
     slots_[i] = storage_.data() + static_cast<std::size_t>(i) * ChunkSize;
   }
   auto fill = [&](std::uint32_t slot, double v)
-  { std::fill_n(slots_[slot], ChunkSize, static_cast<T>(v)); };
+  {
+    std::fill_n(slots_[slot], ChunkSize, static_cast<T>(v));
+  };
   for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
   {
     fill(tape.parameterBase() + i, parameters_[i]);
@@ -269,7 +272,8 @@ void BatchEvaluator<T>::evalRowX(double x0, double dx, std::int64_t first, doubl
   if (outputCount > row_.outputs.size())
   {
     throw std::invalid_argument("BatchEvaluator::evalRowX: the tape has " +
-      std::to_string(row_.outputs.size()) + " output(s), " + std::to_string(outputCount) + " asked");
+      std::to_string(row_.outputs.size()) + " output(s), " + std::to_string(outputCount) +
+      " asked");
   }
   T* s = scalars_.data();
   s[0] = static_cast<T>(x0 + static_cast<double>(first) * dx);
@@ -306,7 +310,8 @@ void BatchEvaluator<T>::evalRowX(double x0, double dx, std::int64_t first, doubl
       for (std::size_t i = 0; i < m; ++i)
       {
         // Coordinates in double, as every other evaluator receives them.
-        xs[i] = static_cast<T>(x0 + static_cast<double>(key.first + static_cast<std::int64_t>(i)) * dx);
+        xs[i] =
+          static_cast<T>(x0 + static_cast<double>(key.first + static_cast<std::int64_t>(i)) * dx);
       }
       rowX_ = key;
     }
@@ -399,7 +404,8 @@ Interval trigRange(bool isSin, const Interval& a)
     return { -1.0, 1.0, true }; // sin(inf) is NaN
   if (!(a.hi - a.lo < 2 * pi))
     return { -1.0, 1.0, a.maybeNaN };
-  double (*f)(double) = isSin ? static_cast<double (*)(double)>(std::sin) : static_cast<double (*)(double)>(std::cos);
+  double (*f)(double) =
+    isSin ? static_cast<double (*)(double)>(std::sin) : static_cast<double (*)(double)>(std::cos);
   double lo = std::min(f(a.lo), f(a.hi));
   double hi = std::max(f(a.lo), f(a.hi));
   const double maxAt = isSin ? pi / 2 : 0.0;
@@ -416,7 +422,8 @@ Interval trigRange(bool isSin, const Interval& a)
 // NaN: minOp(a, b) and maxOp(a, b) return a whenever either operand is NaN, and select takes its
 // second branch when the condition is NaN; so deciding for the first operand is always safe, and
 // deciding for the second needs operands that cannot be NaN.
-Interval intervalOp(Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice)
+Interval intervalOp(
+  Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice)
 {
   choice = Choice::Both;
   switch (op)
@@ -474,7 +481,8 @@ Interval intervalOp(Opcode op, const Interval& a, const Interval& b, const Inter
       if (a.empty())
         return { 0.0, 0.0, false };
       return hull({ detail::signOp(a.lo), detail::signOp(a.hi), false },
-        a.maybeNaN ? Interval{ 0.0, 0.0, false } : Interval{ detail::signOp(a.lo), detail::signOp(a.lo), false });
+        a.maybeNaN ? Interval{ 0.0, 0.0, false }
+                   : Interval{ detail::signOp(a.lo), detail::signOp(a.lo), false });
     case Opcode::Pow:
       // pow(1, NaN) and pow(NaN, 0) are 1: NaN operands do not make a NaN result.
       if (a.empty() || b.empty() || a.maybeNaN || b.maybeNaN)
@@ -649,19 +657,21 @@ ValueGradient chain(double value, const ValueGradient& a, double derivative)
   return r;
 }
 
-ValueGradient combine(double value, const ValueGradient& a, double da, const ValueGradient& b, double db)
+ValueGradient combine(
+  double value, const ValueGradient& a, double da, const ValueGradient& b, double db)
 {
   ValueGradient r;
   r.value = value;
   for (int k = 0; k < 4; ++k)
   {
-    r.gradient[k] = (a.gradient[k] == 0 ? 0 : da * a.gradient[k]) +
-      (b.gradient[k] == 0 ? 0 : db * b.gradient[k]);
+    r.gradient[k] =
+      (a.gradient[k] == 0 ? 0 : da * a.gradient[k]) + (b.gradient[k] == 0 ? 0 : db * b.gradient[k]);
   }
   return r;
 }
 
-ValueGradient gradientOp(Opcode op, const ValueGradient& a, const ValueGradient& b, const ValueGradient& c)
+ValueGradient gradientOp(
+  Opcode op, const ValueGradient& a, const ValueGradient& b, const ValueGradient& c)
 {
   const double x = a.value, y = b.value;
   const double v = applyScalar<double>(op, x, y, c.value);

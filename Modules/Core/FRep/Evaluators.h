@@ -45,8 +45,8 @@ public:
   /// One grid row: points (x0 + (first + i) dx, y, z, t) for i < n, the coordinates computed in
   /// double exactly so. Instructions that do not depend on x run once for the row. Gives the same
   /// values as eval() on those points.
-  void evalRowX(double x0, double dx, std::int64_t first, double y, double z, double t, T* out,
-    std::size_t n)
+  void evalRowX(
+    double x0, double dx, std::int64_t first, double y, double z, double t, T* out, std::size_t n)
   {
     evalRowX(x0, dx, first, y, z, t, &out, 1, n);
   }

@@ -24,6 +24,7 @@ struct OpcodeInfo
   int arity;
 };
 
+// clang-format off
 constexpr OpcodeInfo opcodeTable[] = {
   { "const", 0 }, { "var", 0 }, { "param", 0 }, { "neg", 1 }, { "abs", 1 }, { "sqrt", 1 },
   { "square", 1 }, { "exp", 1 }, { "log", 1 }, { "sin", 1 }, { "cos", 1 }, { "tan", 1 },
@@ -31,6 +32,7 @@ constexpr OpcodeInfo opcodeTable[] = {
   { "mul", 2 }, { "div", 2 }, { "min", 2 }, { "max", 2 }, { "pow", 2 }, { "atan2", 2 },
   { "select", 3 },
 };
+// clang-format on
 static_assert(sizeof(opcodeTable) / sizeof(opcodeTable[0]) == static_cast<int>(Opcode::Count_),
   "opcode table out of date");
 
@@ -348,9 +350,9 @@ Expr Expr::substitute(const std::array<Expr, AxisCount>& map) const
 
 Expr Expr::replace(const Expr& from, const Expr& to) const
 {
-  return rewrite(*this, [&](const Expr& e) -> const Expr* { return e.identical(from) ? &to : nullptr; });
+  return rewrite(
+    *this, [&](const Expr& e) -> const Expr* { return e.identical(from) ? &to : nullptr; });
 }
-
 
 Expr Expr::make(Opcode op, const Expr& a)
 {
@@ -579,8 +581,8 @@ double evaluateReference(
           {
             const auto slot = n.parameterSlot();
             if (slot >= params.size())
-              throw std::out_of_range("evaluateReference: parameter slot " +
-                std::to_string(slot) + " has no value");
+              throw std::out_of_range(
+                "evaluateReference: parameter slot " + std::to_string(slot) + " has no value");
             v = params[slot];
           }
           break;
@@ -593,7 +595,7 @@ double evaluateReference(
           break;
         default:
           v = values.at(n.child(0).id()) >= 0 ? values.at(n.child(1).id())
-                                             : values.at(n.child(2).id());
+                                              : values.at(n.child(2).id());
           break;
       }
       values.emplace(n.id(), v);

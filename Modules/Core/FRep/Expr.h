@@ -35,6 +35,7 @@ enum class Opcode : std::uint8_t
   Constant,
   Variable,  ///< a coordinate (Axis)
   Parameter, ///< a model parameter read from a slot at evaluation time
+
   // unary
   Neg,
   Abs,
@@ -49,6 +50,7 @@ enum class Opcode : std::uint8_t
   Acos,
   Atan,
   Sign, ///< -1, 0 or 1
+
   // binary
   Add,
   Sub,
@@ -58,6 +60,7 @@ enum class Opcode : std::uint8_t
   Max,
   Pow,   ///< real power a^b (NaN for a < 0 and non-integer b, as std::pow)
   Atan2, ///< atan2(a, b)
+
   // ternary
   Select, ///< a >= 0 ? b : c
   Count_

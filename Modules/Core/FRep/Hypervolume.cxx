@@ -104,7 +104,8 @@ TapePtr Hypervolume::compile() const
   return Tape::compile(outputs);
 }
 
-HypervolumeEvaluator::HypervolumeEvaluator(const Hypervolume& hv, const std::vector<double>& parameters)
+HypervolumeEvaluator::HypervolumeEvaluator(
+  const Hypervolume& hv, const std::vector<double>& parameters)
   : hv_(hv)
   , evaluator_(hv.compile(), parameters)
   , outputs_(evaluator_.tape()->outputs().size())
@@ -122,7 +123,8 @@ void HypervolumeEvaluator::eval(const std::array<double, 4>& p, double& value, d
     const bool inPartition = outputs_[k++] >= 0;
     for (std::size_t c = 0; c < a.components.size(); ++c, ++k)
     {
-      *attributes++ = inPartition ? outputs_[k] : (inside ? a.insideDefault[c] : a.outsideDefault[c]);
+      *attributes++ =
+        inPartition ? outputs_[k] : (inside ? a.insideDefault[c] : a.outsideDefault[c]);
     }
   }
 }

@@ -63,7 +63,8 @@ void registerModel(ModelInfo info)
   std::lock_guard<std::mutex> lock(r.mutex);
   if (r.models.count(info.name))
   {
-    throw std::invalid_argument("registerModel: a model named '" + info.name + "' is already registered");
+    throw std::invalid_argument(
+      "registerModel: a model named '" + info.name + "' is already registered");
   }
   std::string name = info.name;
   r.models.emplace(std::move(name), std::move(info));

@@ -173,8 +173,8 @@ void requireBoundedBlendScales(const char* operation, double a0, double a1, doub
 // Bounded blending, thesis L651-L659, with the amplitude a0 of thesis_ch2_3.md 0.4 (a0 = 1 is the
 // thesis formula). L653 tests "r < 1" in one case and "r^2 >= 1" in the other; for r >= 0 these are
 // complementary, and r stays in [0, 1], so disp = (1 - r^2)^3 / (1 + r^2) clamped at 0 covers both.
-Expr boundedBlendExpr(const Expr& f1, const Expr& f2, const Expr& f3, double a0, double a1,
-  double a2, double a3)
+Expr boundedBlendExpr(
+  const Expr& f1, const Expr& f2, const Expr& f3, double a0, double a1, double a2, double a3)
 {
   const Expr r1sq = square(f1 / a1) + square(f2 / a2);
   // L659: (f3/a3)^2 where f3 > 0, else 0; max(f3, 0) gives exactly that without a branch.
@@ -187,8 +187,7 @@ Expr boundedBlendExpr(const Expr& f1, const Expr& f2, const Expr& f3, double a0,
   // changes no result: on the taken branch the denominator is >= r2sq > 0 and absorbs it unless
   // below 1e-292), and min(., 1) is an identity on values that states r <= 1.
   const Expr noBound = -r2sq;
-  const Expr quotient =
-    min(r1sq / (r1sq + r2sq + std::numeric_limits<double>::min()), Expr(1.0));
+  const Expr quotient = min(r1sq / (r1sq + r2sq + std::numeric_limits<double>::min()), Expr(1.0));
   const Expr r = select(noBound, Expr(1.0), quotient);
   const Expr rsq = square(r);
   const Expr oneMinus = max(1.0 - rsq, Expr(0.0));
@@ -233,7 +232,8 @@ std::uint8_t axesOfList(const char* operation, const std::vector<Axis>& axes)
   {
     if (bits & bit(a))
     {
-      throw DomainError(std::string(operation) + ": coordinate " + axisName(a) + " is listed twice");
+      throw DomainError(
+        std::string(operation) + ": coordinate " + axisName(a) + " is listed twice");
     }
     bits |= bit(a);
   }
@@ -275,8 +275,8 @@ Shape intersect(const Shape& a, const Shape& b, double alpha)
 {
   requireSameDomain("intersect", a, b);
   requireAlpha("intersect", alpha);
-  return Shape(
-    rIntersection(a.function(), b.function(), alpha), a.domain(), binaryLabel("intersection", a, b));
+  return Shape(rIntersection(a.function(), b.function(), alpha), a.domain(),
+    binaryLabel("intersection", a, b));
 }
 
 Shape subtract(const Shape& a, const Shape& b, double alpha)
@@ -328,13 +328,15 @@ Shape uniteMinMax(const Shape& a, const Shape& b)
 Shape intersectMinMax(const Shape& a, const Shape& b)
 {
   requireSameDomain("intersectMinMax", a, b);
-  return Shape(min(a.function(), b.function()), a.domain(), binaryLabel("intersectionMinMax", a, b));
+  return Shape(
+    min(a.function(), b.function()), a.domain(), binaryLabel("intersectionMinMax", a, b));
 }
 
 Shape subtractMinMax(const Shape& a, const Shape& b)
 {
   requireSameDomain("subtractMinMax", a, b);
-  return Shape(min(a.function(), -b.function()), a.domain(), binaryLabel("subtractionMinMax", a, b));
+  return Shape(
+    min(a.function(), -b.function()), a.domain(), binaryLabel("subtractionMinMax", a, b));
 }
 
 Shape negate(const Shape& a)
@@ -364,8 +366,8 @@ Shape blendIntersection(const Shape& a, const Shape& b, double a0, double a1, do
     binaryLabel("blendIntersection", a, b));
 }
 
-Shape boundedBlend(const Shape& a, const Shape& b, const Shape& bound, double a1, double a2,
-  double a3, double a0)
+Shape boundedBlend(
+  const Shape& a, const Shape& b, const Shape& bound, double a1, double a2, double a3, double a0)
 {
   requireSameDomain("boundedBlend", a, b);
   requireSameDomain("boundedBlend", a, bound);
@@ -444,7 +446,10 @@ Shape affine(const Shape& a, const std::array<double, 12>& matrix)
   {
     requireFinite("affine", "matrix", c);
   }
-  auto A = [&](int r, int c) { return matrix[static_cast<std::size_t>(4 * r + c)]; };
+  auto A = [&](int r, int c)
+  {
+    return matrix[static_cast<std::size_t>(4 * r + c)];
+  };
   // An axis the shape lacks must be left fixed and uncoupled by the map, or the result would need a
   // coordinate the domain does not have.
   const std::uint8_t have = domainAxes(a.domain());
@@ -558,7 +563,8 @@ Shape taper(const Shape& a, Axis axis, double z1, double z2, double s1, double s
   requireFinite("taper", "s2", s2);
   if (!(z1 < z2))
   {
-    invalid("taper", "parameters must satisfy z1 < z2, got z1 = " + number(z1) + ", z2 = " + number(z2));
+    invalid(
+      "taper", "parameters must satisfy z1 < z2, got z1 = " + number(z1) + ", z2 = " + number(z2));
   }
   // HyperFun's R_hfTaper* rejects non-positive factors; a zero scale has no inverse.
   if (!(s1 > 0.0))
@@ -681,7 +687,8 @@ Shape project(const Shape& a, Axis axis, double lo, double hi, int samples)
   requireFinite("project", "hi", hi);
   if (!(lo < hi))
   {
-    invalid("project", "parameters must satisfy lo < hi, got lo = " + number(lo) + ", hi = " + number(hi));
+    invalid("project",
+      "parameters must satisfy lo < hi, got lo = " + number(lo) + ", hi = " + number(hi));
   }
   if (samples < 2 || samples > 4096)
   {
@@ -715,8 +722,8 @@ Shape metamorphosis(const Shape& a, const Shape& b, double s)
   {
     invalid("metamorphosis", "parameter s must lie in [0, 1], got " + number(s));
   }
-  return Shape((1.0 - s) * a.function() + s * b.function(), a.domain(),
-    binaryLabel("metamorphosis", a, b));
+  return Shape(
+    (1.0 - s) * a.function() + s * b.function(), a.domain(), binaryLabel("metamorphosis", a, b));
 }
 
 Shape metamorphosis(const Shape& a, const Shape& b, double t0, double t1)
@@ -726,7 +733,8 @@ Shape metamorphosis(const Shape& a, const Shape& b, double t0, double t1)
   requireFinite("metamorphosis", "t1", t1);
   if (!(t0 < t1))
   {
-    invalid("metamorphosis", "parameters must satisfy t0 < t1, got t0 = " + number(t0) + ", t1 = " + number(t1));
+    invalid("metamorphosis",
+      "parameters must satisfy t0 < t1, got t0 = " + number(t0) + ", t1 = " + number(t1));
   }
   const Domain d = withTime("metamorphosis", a);
   const Expr s = min(max((Expr::t() - t0) / (t1 - t0), Expr(0.0)), Expr(1.0));
@@ -741,7 +749,8 @@ Shape spaceTimeBlend(const Shape& a, const Shape& b, double t0, double t1, doubl
   requireFinite("spaceTimeBlend", "t1", t1);
   if (!(t0 < t1))
   {
-    invalid("spaceTimeBlend", "parameters must satisfy t0 < t1, got t0 = " + number(t0) + ", t1 = " + number(t1));
+    invalid("spaceTimeBlend",
+      "parameters must satisfy t0 < t1, got t0 = " + number(t0) + ", t1 = " + number(t1));
   }
   if (!(overlap > 0.0 && overlap <= 0.5))
   {
@@ -751,10 +760,10 @@ Shape spaceTimeBlend(const Shape& a, const Shape& b, double t0, double t1, doubl
   const Domain d = withTime("spaceTimeBlend", a);
   // Half-cylinders and bounding slab after thesis_ch5_6.md [EXT] "Space-time blending construction"
   // (F1 = f1 & (t0 - t), F2 = f2 & (t - t1), F3 = (t - t0) & (t1 - t)), with one change: the cuts
-  // are moved into the slab by overlap (t1 - t0). With the cuts exactly on the slab faces, r -> 1 at
-  // the faces kills the displacement there, so just after t0 the slice would be empty (F1 < 0, no
-  // material yet) and the morph would jump. With the cuts inside, F3 <= 0 for t <= t0 gives
-  // F = R-union(F1, F2) with F2 < 0 and tA - t > 0, whose sign is exactly sign(f1) (and likewise
+  // are moved into the slab by overlap (t1 - t0). With the cuts exactly on the slab faces, r -> 1
+  // at the faces kills the displacement there, so just after t0 the slice would be empty (F1 < 0,
+  // no material yet) and the morph would jump. With the cuts inside, F3 <= 0 for t <= t0 gives F =
+  // R-union(F1, F2) with F2 < 0 and tA - t > 0, whose sign is exactly sign(f1) (and likewise
   // sign(f2) for t >= t1).
   const double tA = t0 + overlap * (t1 - t0);
   const double tB = t1 - overlap * (t1 - t0);
@@ -762,7 +771,8 @@ Shape spaceTimeBlend(const Shape& a, const Shape& b, double t0, double t1, doubl
   const Expr F1 = rIntersection(a.function(), tA - t, 0.0);
   const Expr F2 = rIntersection(b.function(), t - tB, 0.0);
   const Expr F3 = rIntersection(t - t0, t1 - t, 0.0);
-  return Shape(boundedBlendExpr(F1, F2, F3, a0, a1, a2, a3), d, binaryLabel("spaceTimeBlend", a, b));
+  return Shape(
+    boundedBlendExpr(F1, F2, F3, a0, a1, a2, a3), d, binaryLabel("spaceTimeBlend", a, b));
 }
 
 } // namespace ictk::frep

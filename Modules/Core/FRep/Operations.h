@@ -58,8 +58,8 @@ Shape boundedBlend(const Shape& a, const Shape& b, const Shape& bound, double a1
 Shape offset(const Shape& a, double d);
 
 // --- space mappings (the query point is inverse-mapped: f'(p) = f(M^-1 p)) -----------------------
-// The mappings act on x, y, z (t is never touched). A shape whose domain lacks one of x, y, z can be
-// mapped as long as the mapping leaves that axis alone (zero shift, unit scale, no coupling);
+// The mappings act on x, y, z (t is never touched). A shape whose domain lacks one of x, y, z can
+// be mapped as long as the mapping leaves that axis alone (zero shift, unit scale, no coupling);
 // otherwise DomainError.
 /// Translation by v [hfShift3D: x' = x - dx].
 Shape shift(const Shape& a, const Vec3& v);

@@ -10,10 +10,10 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <sstream>
-#include <memory>
 #include <thread>
 
 namespace ictk::frep
@@ -171,7 +171,8 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
       slot.emplace(tape, options.parameters);
     }
     Workspace<T>& ws = *slot;
-    const std::int64_t bi = b % bricks[0], bj = (b / bricks[0]) % bricks[1], bk = b / (bricks[0] * bricks[1]);
+    const std::int64_t bi = b % bricks[0], bj = (b / bricks[0]) % bricks[1],
+                       bk = b / (bricks[0] * bricks[1]);
     const std::int64_t i0 = bi * brick[0], j0 = bj * brick[1], k0 = bk * brick[2];
     const std::int64_t i1 = std::min(dims[0], i0 + brick[0]), j1 = std::min(dims[1], j0 + brick[1]),
                        k1 = std::min(dims[2], k0 + brick[2]);
@@ -179,9 +180,12 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
     if (options.prune && tape->choiceCount() > 0)
     {
       Region region;
-      region.axes[0] = { grid.origin[0] + i0 * grid.spacing[0], grid.origin[0] + (i1 - 1) * grid.spacing[0] };
-      region.axes[1] = { grid.origin[1] + j0 * grid.spacing[1], grid.origin[1] + (j1 - 1) * grid.spacing[1] };
-      region.axes[2] = { grid.origin[2] + k0 * grid.spacing[2], grid.origin[2] + (k1 - 1) * grid.spacing[2] };
+      region.axes[0] = { grid.origin[0] + i0 * grid.spacing[0],
+        grid.origin[0] + (i1 - 1) * grid.spacing[0] };
+      region.axes[1] = { grid.origin[1] + j0 * grid.spacing[1],
+        grid.origin[1] + (j1 - 1) * grid.spacing[1] };
+      region.axes[2] = { grid.origin[2] + k0 * grid.spacing[2],
+        grid.origin[2] + (k1 - 1) * grid.spacing[2] };
       region.axes[3] = { grid.time, grid.time };
       ws.interval.eval(region);
       evaluator = &ws.evaluatorFor(ws.interval.choices());
@@ -192,7 +196,8 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
       for (std::int64_t j = j0; j < j1; ++j)
       {
         const double y = grid.origin[1] + j * grid.spacing[1];
-        writeRow(*evaluator, (k * dims[1] + j) * dims[0] + i0, i0, static_cast<std::size_t>(i1 - i0), y, z);
+        writeRow(*evaluator, (k * dims[1] + j) * dims[0] + i0, i0,
+          static_cast<std::size_t>(i1 - i0), y, z);
       }
     }
   };
@@ -208,7 +213,8 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
       sampleBrick(b);
       const std::int64_t n = done.fetch_add(1) + 1;
       // Progress is reported only from the calling thread, as VTK and GUIs expect.
-      if (options.progress && std::this_thread::get_id() == caller && n - lastReported >= reportEvery)
+      if (options.progress && std::this_thread::get_id() == caller &&
+        n - lastReported >= reportEvery)
       {
         lastReported = n;
         if (!options.progress(static_cast<double>(n) / static_cast<double>(brickCount)))
@@ -223,7 +229,8 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
   if (options.threads > 0)
   {
     tbb::task_arena arena(options.threads);
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body); });
+    arena.execute(
+      [&] { tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body); });
   }
   else
   {
@@ -275,7 +282,8 @@ void sampleHypervolume(const Hypervolume& hv, const Grid& grid, T* value,
       {
         rows[k] = buffer.data() + k * n;
       }
-      evaluator.evalRowX(grid.origin[0], grid.spacing[0], i0, y, z, grid.time, rows.data(), outputCount, n);
+      evaluator.evalRowX(
+        grid.origin[0], grid.spacing[0], i0, y, z, grid.time, rows.data(), outputCount, n);
       // The default rule of HypervolumeEvaluator (thesis L715, consistent reading).
       const T* f = rows[0];
       std::size_t k = 1;

@@ -59,8 +59,10 @@ struct SampleOptions
 };
 
 /// Fills `out` (grid.pointCount() values) with the tape's first output.
-void sampleGrid(const TapePtr& tape, const Grid& grid, float* out, const SampleOptions& options = {});
-void sampleGrid(const TapePtr& tape, const Grid& grid, double* out, const SampleOptions& options = {});
+void sampleGrid(
+  const TapePtr& tape, const Grid& grid, float* out, const SampleOptions& options = {});
+void sampleGrid(
+  const TapePtr& tape, const Grid& grid, double* out, const SampleOptions& options = {});
 
 /// Samples a hypervolume in one pass: f into `value` (grid.pointCount() values) and attribute i
 /// into attributes[i] (grid.pointCount() tuples of its component count, interleaved), by the

@@ -203,8 +203,8 @@ TapePtr Tape::build(std::uint32_t parameterCount, std::vector<double> constants,
   {
     slotOfValue[v] = v;
   }
-  tape->slotCount_ =
-    detail::allocateRegisters(ops, leafCount, tape->outputValues_, tape->instructions_, slotOfValue);
+  tape->slotCount_ = detail::allocateRegisters(
+    ops, leafCount, tape->outputValues_, tape->instructions_, slotOfValue);
   for (std::uint32_t v : tape->outputValues_)
   {
     tape->outputs_.push_back(slotOfValue[v]);
@@ -306,7 +306,10 @@ RowProgram Tape::rowProgram(std::uint8_t varyingAxes) const
   const std::size_t valueCount = leafCount + ssa_.size();
   RowProgram p;
   p.scalarSlotCount = static_cast<std::uint32_t>(valueCount);
-  auto varies = [&](std::uint32_t v) { return (axes_[v] & varyingAxes) != 0; };
+  auto varies = [&](std::uint32_t v)
+  {
+    return (axes_[v] & varyingAxes) != 0;
+  };
 
   // Uniform part: scalar code over value ids (no register reuse: it runs once per row).
   std::vector<SsaOp> varyingOps;

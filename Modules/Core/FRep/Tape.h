@@ -30,7 +30,7 @@ struct RowProgram
 {
   struct Output
   {
-    bool varying;       ///< true: a chunk slot; false: a scalar slot (constant along the row)
+    bool varying; ///< true: a chunk slot; false: a scalar slot (constant along the row)
     std::uint32_t slot;
   };
   /// Scalar code over value ids (slots [0, 4) x, y, z, t; parameters; constants; temporaries).
@@ -78,7 +78,10 @@ public:
   std::uint32_t constantBase() const { return 4 + parameterCount_; }
   const std::vector<double>& constants() const { return constants_; }
   /// First temporary slot (everything below is an input, parameter or constant).
-  std::uint32_t temporaryBase() const { return constantBase() + static_cast<std::uint32_t>(constants_.size()); }
+  std::uint32_t temporaryBase() const
+  {
+    return constantBase() + static_cast<std::uint32_t>(constants_.size());
+  }
   /// The slot that holds each output after evaluation.
   const std::vector<std::uint32_t>& outputs() const { return outputs_; }
   /// Bit i set when some output depends on Axis(i).
@@ -98,8 +101,9 @@ public:
 
 private:
   Tape() = default;
-  static std::shared_ptr<const Tape> build(std::uint32_t parameterCount, std::vector<double> constants,
-    std::vector<TapeSsa> ssa, std::vector<std::uint32_t> outputValues);
+  static std::shared_ptr<const Tape> build(std::uint32_t parameterCount,
+    std::vector<double> constants, std::vector<TapeSsa> ssa,
+    std::vector<std::uint32_t> outputValues);
 
   std::uint32_t parameterCount_ = 0;
   std::vector<double> constants_;

@@ -272,8 +272,9 @@ void Sample(ictkFRepSampler* self, const Plan& plan, const std::vector<double>& 
 {
   const std::int64_t n = plan.grid.pointCount();
   // Without attributes, sample the geometry alone (a hypervolume with no attribute).
-  const frep::Hypervolume hv =
-    self->GetComputeAttributes() ? *plan.hv : frep::Hypervolume(plan.hv->geometry(), plan.hv->threshold());
+  const frep::Hypervolume hv = self->GetComputeAttributes()
+    ? *plan.hv
+    : frep::Hypervolume(plan.hv->geometry(), plan.hv->threshold());
 
   auto f = NewArray<T>("f", 1, n);
   std::vector<vtkSmartPointer<vtkAOSDataArrayTemplate<T>>> attributeArrays;
