@@ -174,7 +174,6 @@ std::array<std::int64_t, 3> ParseDims(const std::string& text)
 
 const frep::ModelInfo& FindModel(const std::string& name)
 {
-  frep::registerBundledModels();
   try
   {
     return frep::findModel(name);
@@ -401,7 +400,6 @@ double Seconds(std::chrono::steady_clock::time_point since)
 
 int RunModels(bool json)
 {
-  frep::registerBundledModels();
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   std::size_t width = 4;
   for (const std::string& name : frep::modelNames())

@@ -337,7 +337,6 @@ int main(int argc, char** argv)
     return 1;
   }
 
-  registerBundledModels();
   vtkSMPTools::Initialize(0); // all threads, like sampleGrid's default
   std::printf("threads: ICTK (TBB) %d, VTK (vtkSMPTools backend %s) %d\n",
     tbb::info::default_concurrency(), vtkSMPTools::GetBackend(),

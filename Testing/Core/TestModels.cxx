@@ -22,7 +22,6 @@ namespace
 {
 Hypervolume build(const std::string& name)
 {
-  registerBundledModels();
   return findModel(name).build();
 }
 
@@ -144,12 +143,9 @@ void expectOutsideOnBounds(const ModelInfo& info, double t = 0)
 // --- registry
 // -------------------------------------------------------------------------------------
 
-TEST(ModelRegistry, BundledModelsAreRegisteredOnce)
+TEST(ModelRegistry, BundledModelsAreRegisteredFromTheStart)
 {
-  registerBundledModels();
   const std::vector<std::string> before = modelNames();
-  registerBundledModels(); // idempotent
-  EXPECT_EQ(modelNames(), before);
   for (const char* name :
     { "sphere", "csg3", "blend100", "random1000", "walnut", "disk2d", "morph" })
   {
@@ -163,7 +159,6 @@ TEST(ModelRegistry, BundledModelsAreRegisteredOnce)
 
 TEST(ModelRegistry, UnknownNameListsTheKnownModels)
 {
-  registerBundledModels();
   try
   {
     findModel("no-such-model");
@@ -181,7 +176,6 @@ TEST(ModelRegistry, UnknownNameListsTheKnownModels)
 
 TEST(ModelRegistry, RegisterRejectsDuplicatesAndBadInfo)
 {
-  registerBundledModels();
   ModelInfo info;
   info.name = "sphere";
   info.boundsLo = { -1, -1, -1 };
@@ -222,7 +216,6 @@ TEST(ModelRegistry, ConcurrentRegistrationAndLookup)
       {
         try
         {
-          registerBundledModels();
           for (int i = 0; i < 50; ++i)
           {
             ModelInfo info;
@@ -257,7 +250,6 @@ TEST(ModelRegistry, ConcurrentRegistrationAndLookup)
 
 TEST(BundledModels, BoundsContainEveryModel)
 {
-  registerBundledModels();
   for (const char* name : { "sphere", "csg3", "blend100", "random1000", "walnut", "disk2d" })
   {
     expectOutsideOnBounds(findModel(name));

@@ -55,7 +55,7 @@ Expr csgField(const CsgRecipe& recipe);
 /// d_i = max(lo_i - p_i, p_i - hi_i). Every side must be longer than 0.
 Expr vtkBoxField(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
 
-/// Every bundled model (registerBundledModels() registers these).
+/// Every bundled model (the registry starts with these).
 std::vector<ModelInfo> modelInfos();
 
 } // namespace ictk::frep::bundled

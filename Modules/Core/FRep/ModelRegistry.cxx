@@ -17,13 +17,26 @@ struct Registry
   std::mutex mutex;
   // std::map: references returned by findModel stay valid while other models are added.
   std::map<std::string, ModelInfo> models;
-  bool bundledRegistered = false;
 };
 
+void checkInfo(const ModelInfo& info);
+
+// The registry starts with the bundled models, so that every user of a name sees them and a
+// user model can never shadow one.
 Registry& registry()
 {
-  static Registry r;
-  return r;
+  static Registry* r = []
+  {
+    auto* created = new Registry;
+    for (ModelInfo& info : bundled::modelInfos())
+    {
+      checkInfo(info);
+      std::string name = info.name;
+      created->models.emplace(std::move(name), std::move(info));
+    }
+    return created;
+  }();
+  return *r;
 }
 
 void checkInfo(const ModelInfo& info)
@@ -52,7 +65,7 @@ std::string knownNames(const Registry& r)
   {
     names += (names.empty() ? "" : ", ") + entry.first;
   }
-  return names.empty() ? "(none; call registerBundledModels() first)" : names;
+  return names;
 }
 } // namespace
 
@@ -93,34 +106,6 @@ std::vector<std::string> modelNames()
     names.push_back(entry.first);
   }
   return names;
-}
-
-void registerBundledModels()
-{
-  Registry& r = registry();
-  std::lock_guard<std::mutex> lock(r.mutex);
-  if (r.bundledRegistered)
-  {
-    return;
-  }
-  std::vector<ModelInfo> models = bundled::modelInfos();
-  // All or nothing: check every name before inserting any, so that a clash leaves the registry
-  // as it was and a later call can still succeed once the clash is resolved.
-  for (const ModelInfo& info : models)
-  {
-    checkInfo(info);
-    if (r.models.count(info.name))
-    {
-      throw std::invalid_argument("registerBundledModels: a model named '" + info.name +
-        "' is already registered and would be shadowed by the bundled model");
-    }
-  }
-  for (ModelInfo& info : models)
-  {
-    std::string name = info.name;
-    r.models.emplace(std::move(name), std::move(info));
-  }
-  r.bundledRegistered = true;
 }
 
 } // namespace ictk::frep

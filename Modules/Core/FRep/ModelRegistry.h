@@ -23,12 +23,11 @@ struct ModelInfo
   std::function<Hypervolume()> build;
 };
 
-/// Registers a model; throws std::invalid_argument if the name is taken.
+/// Registers a model; throws std::invalid_argument if the name is taken (the models shipped with
+/// ICTK are registered from the start).
 void registerModel(ModelInfo info);
 /// Returns the model or throws std::invalid_argument("unknown model 'name'; known models: ...").
 const ModelInfo& findModel(const std::string& name);
 std::vector<std::string> modelNames();
-/// Registers the models shipped with ICTK (idempotent).
-void registerBundledModels();
 
 } // namespace ictk::frep

@@ -119,14 +119,6 @@ void ictkFRepImplicitFunction::Rebuild()
     }
     else if (this->ModelName && *this->ModelName)
     {
-      try
-      {
-        frep::registerBundledModels();
-      }
-      catch (const std::exception&)
-      {
-        // A user model already holds a bundled name; the registry is still usable as it is.
-      }
       const frep::Hypervolume hv = frep::findModel(this->ModelName).build();
       tape = frep::Tape::compile(hv.geometry().function());
     }

@@ -68,14 +68,6 @@ struct ictkFRepSampler::Internals
     this->Resolved.reset();
     try
     {
-      try
-      {
-        frep::registerBundledModels();
-      }
-      catch (const std::exception&)
-      {
-        // A user model already holds a bundled name; the registry is still usable as it is.
-      }
       const frep::ModelInfo& info = frep::findModel(modelName);
       this->Resolved = std::make_unique<frep::Hypervolume>(info.build());
       this->ResolvedName = modelName;
