@@ -174,21 +174,6 @@ void BatchEvaluator<T>::setParameters(const std::vector<double>& parameters)
 }
 
 template <typename T>
-void BatchEvaluator<T>::setTape(TapePtr tape)
-{
-  if (tape->parameterCount() > parameters_.size())
-  {
-    throw std::invalid_argument("BatchEvaluator::setTape: the new tape needs more parameters");
-  }
-  if (tape == tape_)
-  {
-    return;
-  }
-  tape_ = std::move(tape);
-  prepare();
-}
-
-template <typename T>
 void BatchEvaluator<T>::prepare()
 {
   const Tape& tape = *tape_;

@@ -54,8 +54,6 @@ public:
   /// (n values each).
   void evalRowX(double x0, double dx, std::int64_t first, double y, double z, double t,
     T* const* outputs, std::size_t outputCount, std::size_t n);
-  /// Replaces the tape (e.g. by a region's simplified tape) keeping the parameters.
-  void setTape(TapePtr tape);
   const TapePtr& tape() const { return tape_; }
 
 private:

@@ -96,9 +96,6 @@ public:
   /// Splits the tape for rows along which only `varyingAxes` (a mask of axes) change.
   RowProgram rowProgram(std::uint8_t varyingAxes) const;
 
-  /// The SSA form (one entry per instruction, same order as instructions()).
-  const std::vector<TapeSsa>& ssa() const { return ssa_; }
-
 private:
   Tape() = default;
   static std::shared_ptr<const Tape> build(std::uint32_t parameterCount,
