@@ -23,11 +23,14 @@
 #include <vtkFlyingEdges3D.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
+#include <vtkOBJWriter.h>
 #include <vtkObjectFactory.h>
 #include <vtkOutputWindow.h>
+#include <vtkPLYWriter.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkSMPTools.h>
+#include <vtkSTLWriter.h>
 #include <vtkSmartPointer.h>
 #include <vtkXMLImageDataWriter.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -38,7 +41,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <climits>
@@ -285,8 +290,12 @@ public:
       throw UserError(
         "cannot write '" + destination + "': folder '" + folder.string() + "' does not exist");
     }
-    std::string pattern = (folder / ("." + path.filename().string() + ".tmp-XXXXXX")).string();
-    const int fd = mkstemp(pattern.data());
+    // The temporary name keeps the extension: some writers (vtkPLYWriter) append theirs
+    // to a file name that does not end with it.
+    const std::string extension = path.extension().string();
+    std::string pattern =
+      (folder / ("." + path.stem().string() + ".tmp-XXXXXX" + extension)).string();
+    const int fd = mkstemps(pattern.data(), static_cast<int>(extension.size()));
     if (fd < 0)
     {
       throw UserError("cannot write '" + destination + "': " + std::strerror(errno));
@@ -559,7 +568,23 @@ void AttachBoundaryAttributes(vtkPolyData* surface, const frep::Hypervolume& hv,
   }
 }
 
-struct SampleCommandOptions
+/// A model ready to sample: its hypervolume and a box that holds it.
+struct ResolvedModel
+{
+  std::string Name;
+  frep::Hypervolume Model;
+  std::array<double, 3> Lo;
+  std::array<double, 3> Hi;
+};
+
+ResolvedModel ResolveModel(const std::string& name)
+{
+  const frep::ModelInfo& info = FindModel(name);
+  return { info.name, info.build(), info.boundsLo, info.boundsHi };
+}
+
+/// Options shared by the commands that sample a model on a grid (sample, mesh).
+struct GridCommandOptions
 {
   std::string Model;
   std::string Output;
@@ -568,15 +593,36 @@ struct SampleCommandOptions
   std::string Bounds;
   double Time = 0;
   int Threads = 0;
-  bool Double = false;
-  std::string Surface;
   std::string Params;
+
+  void AddTo(CLI::App* command, std::int64_t defaultResolution)
+  {
+    this->Resolution = defaultResolution;
+    command->add_option("model", this->Model, "Model name (see `ictk models`)")->required();
+    CLI::Option* resolution = command->add_option("--resolution", this->Resolution,
+      "Points per axis (default " + std::to_string(defaultResolution) + ")");
+    CLI::Option* dims = command->add_option("--dims", this->Dims, "Points per axis: NX,NY,NZ");
+    resolution->excludes(dims);
+    command->add_option(
+      "--bounds", this->Bounds, "Sampled box x0,x1,y0,y1,z0,z1 (default: the model's bounds)");
+    command->add_option("--time", this->Time, "Time t (default 0)");
+    command->add_option("--threads", this->Threads, "Threads (default: all cores)");
+    command->add_option("--params", this->Params, "Model parameters: p1,p2,...");
+  }
 };
 
-int RunSample(const SampleCommandOptions& o)
+/// The grid a command samples, checked before anything is allocated or written.
+struct GridPlan
 {
-  const frep::ModelInfo& info = FindModel(o.Model);
-  const std::vector<double> params = ParseParameters(o.Params);
+  ResolvedModel Model;
+  std::vector<double> Params;
+  std::array<std::int64_t, 3> Dims;
+  frep::Grid Grid;
+};
+
+GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
+{
+  GridPlan plan{ ResolveModel(o.Model), ParseParameters(o.Params), {}, {} };
   if (!std::isfinite(o.Time))
   {
     throw UserError("--time must be a finite number");
@@ -585,8 +631,8 @@ int RunSample(const SampleCommandOptions& o)
   {
     throw UserError("--threads must be 0 (automatic) or more, got " + std::to_string(o.Threads));
   }
-
-  std::array<double, 3> lo = info.boundsLo, hi = info.boundsHi;
+  std::array<double, 3>& lo = plan.Model.Lo;
+  std::array<double, 3>& hi = plan.Model.Hi;
   if (!o.Bounds.empty())
   {
     const std::vector<double> b = ParseNumbers(
@@ -605,8 +651,7 @@ int RunSample(const SampleCommandOptions& o)
       }
     }
   }
-
-  std::array<std::int64_t, 3> dims;
+  std::array<std::int64_t, 3>& dims = plan.Dims;
   if (!o.Dims.empty())
   {
     dims = ParseDims(o.Dims);
@@ -636,22 +681,10 @@ int RunSample(const SampleCommandOptions& o)
       dims[a] = 1;
     }
   }
-
-  const frep::Hypervolume hv = info.build();
-  std::size_t values = 1 + hv.attributeComponentCount();
-  for (const frep::Attribute& a : hv.attributes())
-  {
-    if (a.components.size() > 1)
-    {
-      ++values; // the sampler's scratch component
-      break;
-    }
-  }
-  const std::size_t bytesPerPoint = values * (o.Double ? sizeof(double) : sizeof(float));
-  const frep::Grid grid = frep::gridOverBox(lo, hi, dims, o.Time);
+  plan.Grid = frep::gridOverBox(lo, hi, dims, o.Time);
   try
   {
-    frep::checkGrid(grid, bytesPerPoint);
+    frep::checkGrid(plan.Grid, (1 + plan.Model.Model.attributeComponentCount()) * bytesPerValue);
   }
   catch (const std::invalid_argument& e)
   {
@@ -666,33 +699,32 @@ int RunSample(const SampleCommandOptions& o)
         " points along one axis is more than VTK's limit of " + std::to_string(INT_MAX));
     }
   }
-
-  // Fail on an unwritable destination before spending time on sampling.
-  AtomicOutput volumeFile(o.Output);
-  std::unique_ptr<AtomicOutput> surfaceFile;
-  if (!o.Surface.empty())
-  {
-    surfaceFile = std::make_unique<AtomicOutput>(o.Surface);
-  }
-
-  ictkCaptureOutputWindow* messages = CaptureVtkMessages();
   if (o.Threads > 0)
   {
     vtkSMPTools::Initialize(o.Threads);
   }
+  return plan;
+}
 
+/// Samples the planned grid with a progress display; null when interrupted (Ctrl-C).
+vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, bool asDouble,
+  bool attributes, ictkCaptureOutputWindow* messages)
+{
   vtkNew<ictkFRepSampler> sampler;
-  sampler->SetHypervolume(hv);
-  sampler->SetParameters(params);
+  sampler->SetHypervolume(plan.Model.Model);
+  sampler->SetParameters(plan.Params);
+  const auto& lo = plan.Model.Lo;
+  const auto& hi = plan.Model.Hi;
   sampler->SetModelBounds(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
   sampler->SetSampleDimensions(
-    static_cast<int>(dims[0]), static_cast<int>(dims[1]), static_cast<int>(dims[2]));
-  sampler->SetTime(o.Time);
-  sampler->SetNumberOfThreads(o.Threads);
-  sampler->SetOutputScalarType(o.Double ? VTK_DOUBLE : VTK_FLOAT);
+    static_cast<int>(plan.Dims[0]), static_cast<int>(plan.Dims[1]), static_cast<int>(plan.Dims[2]));
+  sampler->SetTime(plan.Grid.time);
+  sampler->SetNumberOfThreads(threads);
+  sampler->SetOutputScalarType(asDouble ? VTK_DOUBLE : VTK_FLOAT);
+  sampler->SetComputeAttributes(attributes);
 
   ProgressReporter progress;
-  progress.Label = "sampling " + info.name;
+  progress.Label = "sampling " + plan.Model.Name;
   vtkNew<vtkCallbackCommand> onProgress;
   onProgress->SetCallback(OnProgress);
   onProgress->SetClientData(&progress);
@@ -700,23 +732,141 @@ int RunSample(const SampleCommandOptions& o)
 
   std::signal(SIGINT, OnInterrupt);
   std::signal(SIGTERM, OnInterrupt);
-
-  const auto t0 = std::chrono::steady_clock::now();
-  std::size_t errorsBefore = messages->Errors.size();
+  const std::size_t errorsBefore = messages->Errors.size();
   sampler->Update();
   progress.End();
   if (Interrupted)
   {
-    std::cerr << "ictk: interrupted; nothing written\n";
-    return ExitInterrupted;
+    return nullptr;
   }
   ThrowIfVtkFailed(messages, errorsBefore, "sampling failed");
-  vtkImageData* image = sampler->GetOutput();
-  if (image->GetNumberOfPoints() != grid.pointCount())
+  vtkSmartPointer<vtkImageData> image = sampler->GetOutput();
+  if (image->GetNumberOfPoints() != plan.Grid.pointCount())
   {
     throw UserError("sampling failed: the output has " +
       std::to_string(image->GetNumberOfPoints()) + " points instead of " +
-      std::to_string(grid.pointCount()));
+      std::to_string(plan.Grid.pointCount()));
+  }
+  return image;
+}
+
+/// The surface f = 0 of a sampled image (Flying Edges), with outward normals and the model's
+/// attributes evaluated at its vertices.
+vtkSmartPointer<vtkPolyData> ExtractSurface(
+  vtkImageData* image, const GridPlan& plan, ictkCaptureOutputWindow* messages)
+{
+  vtkNew<vtkFlyingEdges3D> contour;
+  contour->SetInputData(image);
+  contour->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "f");
+  contour->SetValue(0, 0.0);
+  // f grows inwards, so the negated gradient Flying Edges uses for normals points outwards.
+  contour->ComputeNormalsOn();
+  contour->ComputeScalarsOff();
+  contour->InterpolateAttributesOff();
+  const std::size_t errorsBefore = messages->Errors.size();
+  contour->Update();
+  ThrowIfVtkFailed(messages, errorsBefore, "surface extraction failed");
+  vtkSmartPointer<vtkPolyData> surface = contour->GetOutput();
+  // Interpolating the grid's attribute arrays would mix the values on both sides of the
+  // boundary (an attribute usually jumps there); evaluate them instead just inside the solid,
+  // a thousandth of a grid step from each vertex against its outward normal.
+  const auto& spacing = plan.Grid.spacing;
+  const double step = std::min({ spacing[0], spacing[1], spacing[2] });
+  AttachBoundaryAttributes(surface, plan.Model.Model, plan.Params, plan.Grid.time, 1e-3 * step);
+  return surface;
+}
+
+std::string LowerExtension(const std::string& path)
+{
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+const char* const SurfaceFormats = ".vtp, .stl, .ply or .obj";
+
+bool IsSurfaceFormat(const std::string& path)
+{
+  const std::string ext = LowerExtension(path);
+  return ext == ".vtp" || ext == ".stl" || ext == ".ply" || ext == ".obj";
+}
+
+/// Writes a surface in the format its path names (checked by IsSurfaceFormat).
+void WriteSurface(vtkPolyData* surface, AtomicOutput& file, const std::string& path,
+  ictkCaptureOutputWindow* messages)
+{
+  const std::string ext = LowerExtension(path);
+  // Every writer is given the temporary path, and reports failure through Write() and its error
+  // code (vtkXMLWriter is not a vtkWriter, so each kind is driven on its own).
+  auto run = [&](auto* writer)
+  {
+    writer->SetInputData(surface);
+    writer->SetFileName(file.Path().c_str());
+    return writer->Write() == 1 && writer->GetErrorCode() == 0;
+  };
+  const std::size_t errorsBefore = messages->Errors.size();
+  bool written = false;
+  if (ext == ".vtp")
+  {
+    vtkNew<vtkXMLPolyDataWriter> xml;
+    xml->SetDataModeToAppended();
+    xml->EncodeAppendedDataOff();
+    written = run(xml.Get());
+  }
+  else if (ext == ".stl")
+  {
+    vtkNew<vtkSTLWriter> stl;
+    stl->SetFileTypeToBinary();
+    written = run(stl.Get());
+  }
+  else if (ext == ".ply")
+  {
+    vtkNew<vtkPLYWriter> ply;
+    ply->SetFileTypeToBinary();
+    written = run(ply.Get());
+  }
+  else
+  {
+    vtkNew<vtkOBJWriter> obj;
+    written = run(obj.Get());
+  }
+  ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + path + "'");
+  if (!written)
+  {
+    throw UserError("cannot write '" + path + "'");
+  }
+  file.Commit();
+}
+
+struct SampleCommandOptions : GridCommandOptions
+{
+  bool Double = false;
+  std::string Surface;
+};
+
+int RunSample(const SampleCommandOptions& o)
+{
+  if (!o.Surface.empty() && !IsSurfaceFormat(o.Surface))
+  {
+    throw UserError("--surface: '" + o.Surface + "' is not a " + SurfaceFormats + " file");
+  }
+  const GridPlan plan = PlanGrid(o, o.Double ? sizeof(double) : sizeof(float));
+  // Fail on an unwritable destination before spending time on sampling.
+  AtomicOutput volumeFile(o.Output);
+  std::unique_ptr<AtomicOutput> surfaceFile;
+  if (!o.Surface.empty())
+  {
+    surfaceFile = std::make_unique<AtomicOutput>(o.Surface);
+  }
+  ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+
+  const auto t0 = std::chrono::steady_clock::now();
+  vtkSmartPointer<vtkImageData> image = SampleImage(plan, o.Threads, o.Double, true, messages);
+  if (!image)
+  {
+    std::cerr << "ictk: interrupted; nothing written\n";
+    return ExitInterrupted;
   }
   const double sampleSeconds = Seconds(t0);
 
@@ -726,7 +876,7 @@ int RunSample(const SampleCommandOptions& o)
   writer->SetFileName(volumeFile.Path().c_str());
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
-  errorsBefore = messages->Errors.size();
+  std::size_t errorsBefore = messages->Errors.size();
   if (writer->Write() != 1 || writer->GetErrorCode() != 0)
   {
     ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
@@ -736,8 +886,8 @@ int RunSample(const SampleCommandOptions& o)
   volumeFile.Commit();
   const double writeSeconds = Seconds(t1);
 
-  std::cout << "wrote " << o.Output << " (" << dims[0] << " x " << dims[1] << " x " << dims[2]
-            << " points; arrays:";
+  std::cout << "wrote " << o.Output << " (" << plan.Dims[0] << " x " << plan.Dims[1] << " x "
+            << plan.Dims[2] << " points; arrays:";
   vtkPointData* pd = image->GetPointData();
   for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
   {
@@ -749,39 +899,37 @@ int RunSample(const SampleCommandOptions& o)
   if (surfaceFile)
   {
     const auto t2 = std::chrono::steady_clock::now();
-    vtkNew<vtkFlyingEdges3D> contour;
-    contour->SetInputData(image);
-    contour->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "f");
-    contour->SetValue(0, 0.0);
-    // f grows inwards, so the negated gradient Flying Edges uses for normals points outwards.
-    contour->ComputeNormalsOn();
-    contour->ComputeScalarsOff();
-    contour->InterpolateAttributesOff();
-    errorsBefore = messages->Errors.size();
-    contour->Update();
-    ThrowIfVtkFailed(messages, errorsBefore, "surface extraction failed");
-    vtkPolyData* surface = contour->GetOutput();
-    // Interpolating the grid's attribute arrays would mix the values on both sides of the
-    // boundary (an attribute usually jumps there); evaluate them instead just inside the solid,
-    // a thousandth of a grid step from each vertex against its outward normal.
-    const double step = std::min({ grid.spacing[0], grid.spacing[1], grid.spacing[2] });
-    AttachBoundaryAttributes(surface, hv, params, o.Time, 1e-3 * step);
-
-    vtkNew<vtkXMLPolyDataWriter> surfaceWriter;
-    surfaceWriter->SetInputData(surface);
-    surfaceWriter->SetFileName(surfaceFile->Path().c_str());
-    surfaceWriter->SetDataModeToAppended();
-    surfaceWriter->EncodeAppendedDataOff();
-    if (surfaceWriter->Write() != 1 || surfaceWriter->GetErrorCode() != 0)
-    {
-      ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Surface + "'");
-      throw UserError("cannot write '" + o.Surface + "'");
-    }
-    ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Surface + "'");
-    surfaceFile->Commit();
+    vtkSmartPointer<vtkPolyData> surface = ExtractSurface(image, plan, messages);
+    WriteSurface(surface, *surfaceFile, o.Surface, messages);
     std::cout << "wrote " << o.Surface << " (" << surface->GetNumberOfPoints() << " points, "
               << surface->GetNumberOfPolys() << " triangles) in " << Seconds(t2) << " s\n";
   }
+  return 0;
+}
+
+int RunMesh(const GridCommandOptions& o)
+{
+  if (!IsSurfaceFormat(o.Output))
+  {
+    throw UserError("-o: '" + o.Output + "' is not a " + SurfaceFormats + " file");
+  }
+  const GridPlan plan = PlanGrid(o, sizeof(float));
+  AtomicOutput file(o.Output);
+  ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+  const auto t0 = std::chrono::steady_clock::now();
+  // The attributes are evaluated on the surface itself; the grid needs only f.
+  vtkSmartPointer<vtkImageData> image = SampleImage(plan, o.Threads, false, false, messages);
+  if (!image)
+  {
+    std::cerr << "ictk: interrupted; nothing written\n";
+    return ExitInterrupted;
+  }
+  vtkSmartPointer<vtkPolyData> surface = ExtractSurface(image, plan, messages);
+  WriteSurface(surface, file, o.Output, messages);
+  std::cout << "wrote " << o.Output << " (" << surface->GetNumberOfPoints() << " points, "
+            << surface->GetNumberOfPolys() << " triangles from a " << plan.Dims[0] << " x "
+            << plan.Dims[1] << " x " << plan.Dims[2] << " grid) in " << std::fixed
+            << std::setprecision(3) << Seconds(t0) << " s\n";
   return 0;
 }
 
@@ -806,21 +954,19 @@ int Run(int argc, char** argv)
 
   SampleCommandOptions sampleOptions;
   CLI::App* sample = app.add_subcommand("sample", "Sample a model on a regular grid (.vti)");
-  sample->add_option("model", sampleOptions.Model, "Model name (see `ictk models`)")->required();
+  sampleOptions.AddTo(sample, 64);
   sample->add_option("-o,--output", sampleOptions.Output, "Output image (.vti)")->required();
-  CLI::Option* resolution =
-    sample->add_option("--resolution", sampleOptions.Resolution, "Points per axis (default 64)");
-  CLI::Option* dims = sample->add_option("--dims", sampleOptions.Dims, "Points per axis: NX,NY,NZ");
-  resolution->excludes(dims);
-  sample->add_option("--bounds", sampleOptions.Bounds,
-    "Sampled box x0,x1,y0,y1,z0,z1 (default: the model's bounds)");
-  sample->add_option("--time", sampleOptions.Time, "Time t (default 0)");
-  sample->add_option("--threads", sampleOptions.Threads, "Threads (default: all cores)");
   sample->add_flag(
     "--double", sampleOptions.Double, "Write double-precision arrays (default float)");
   sample->add_option("--surface", sampleOptions.Surface,
-    "Also extract the surface f = 0 (Flying Edges) into this .vtp");
-  sample->add_option("--params", sampleOptions.Params, "Model parameters: p1,p2,...");
+    "Also extract the surface f = 0 (Flying Edges) into this .vtp, .stl, .ply or .obj");
+
+  GridCommandOptions meshOptions;
+  CLI::App* mesh = app.add_subcommand("mesh",
+    "Extract the surface f = 0 on a uniform grid (Flying Edges) as .vtp, .stl, .ply or .obj");
+  meshOptions.AddTo(mesh, 128);
+  mesh->add_option("-o,--output", meshOptions.Output, "Output surface (.vtp, .stl, .ply, .obj)")
+    ->required();
 
   try
   {
@@ -850,6 +996,10 @@ int Run(int argc, char** argv)
   if (*eval)
   {
     return RunEval(evalOptions);
+  }
+  if (*mesh)
+  {
+    return RunMesh(meshOptions);
   }
   return RunSample(sampleOptions);
 }

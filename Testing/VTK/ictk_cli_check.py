@@ -188,6 +188,39 @@ def check_error(ictk, work, pattern, args):
     no_leftovers(work)
 
 
+def check_mesh_formats(ictk, work):
+    """ictk mesh writes the same surface in every format; each file is read back by VTK's own
+    reader for that format and measured: the unit sphere's area is 4 pi within 1 %."""
+    import vtk
+    counts = {}
+    readers = {"vtp": vtk.vtkXMLPolyDataReader, "stl": vtk.vtkSTLReader, "ply": vtk.vtkPLYReader,
+               "obj": vtk.vtkOBJReader}
+    for ext, reader_class in readers.items():
+        path = os.path.join(work, "sphere." + ext)
+        p = run(ictk, ["mesh", "sphere", "-o", path, "--resolution", "80"])
+        if path not in p.stdout:
+            sys.exit(f"FAIL: mesh did not print {path}:\n{p.stdout}")
+        reader = reader_class()
+        reader.SetFileName(path)
+        triangles = vtk.vtkTriangleFilter()
+        triangles.SetInputConnection(reader.GetOutputPort())
+        mass = vtk.vtkMassProperties()
+        mass.SetInputConnection(triangles.GetOutputPort())
+        mass.Update()
+        counts[ext] = triangles.GetOutput().GetNumberOfPolys()
+        near(mass.GetSurfaceArea(), 4 * math.pi, 0.01 * 4 * math.pi, f"area of the .{ext} sphere")
+        near(mass.GetVolume(), 4 / 3 * math.pi, 0.01 * 4 / 3 * math.pi, f"volume of the .{ext} sphere")
+    if len(set(counts.values())) != 1 or counts["vtp"] < 1000:
+        sys.exit(f"FAIL: triangle counts differ between formats: {counts}")
+    # The .vtp carries the attributes, evaluated on the surface.
+    path = os.path.join(work, "walnut.vtp")
+    run(ictk, ["mesh", "walnut", "-o", path, "--resolution", "40"])
+    material = read_polydata(path).GetPointData().GetArray("material")
+    if material is None:
+        sys.exit("FAIL: no material on the walnut surface")
+    no_leftovers(work)
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -203,6 +236,7 @@ def main():
         "sample-sphere": check_sample_sphere,
         "sample-walnut": check_sample_walnut,
         "sample-disk2d": check_sample_disk2d,
+        "mesh-formats": check_mesh_formats,
     }
     if check == "expect-error":
         if len(rest) < 2 or rest[1] != "--":
