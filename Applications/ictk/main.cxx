@@ -9,10 +9,12 @@
 // Every user error ends in one line "ictk: error: ..." on stderr and exit code 2; nothing is
 // left half-written (outputs go to a temporary file in the target folder, renamed on success).
 
+#include "FRep/Bounds.h"
 #include "FRep/Evaluators.h"
 #include "FRep/Hypervolume.h"
 #include "FRep/ModelRegistry.h"
 #include "FRep/Sampling.h"
+#include "Lang/ModelFile.h"
 
 #include "ictkFRepSampler.h"
 
@@ -62,6 +64,7 @@
 #include <vector>
 
 namespace frep = ictk::frep;
+namespace lang = ictk::lang;
 namespace fs = std::filesystem;
 
 namespace
@@ -72,6 +75,13 @@ class UserError : public std::runtime_error
 {
 public:
   using std::runtime_error::runtime_error;
+};
+
+/// A model file's diagnostics: already "file:line:col: error: ..." lines, printed as they are.
+class ModelFileError : public UserError
+{
+public:
+  using UserError::UserError;
 };
 
 constexpr int ExitUserError = 2;
@@ -439,6 +449,87 @@ int RunModels(bool json)
   return 0;
 }
 
+/// A model ready to sample: its hypervolume and a box that holds it.
+struct ResolvedModel
+{
+  std::string Name;
+  frep::Hypervolume Model;
+  std::array<double, 3> Lo;
+  std::array<double, 3> Hi;
+};
+
+/// The box searched for a file model's bounds when the file gives none (HyperFun's default
+/// modelling box is [-10, 10]^3).
+constexpr double FileSearchHalfWidth = 10.0;
+
+/// Opens a model file, turning its diagnostics into the user error (they name file, line and
+/// column already).
+lang::ModelFile OpenModelFile(const std::string& path)
+{
+  try
+  {
+    return lang::loadModelFile(path);
+  }
+  catch (const lang::ParseError& e)
+  {
+    // Every diagnostic, each "file:line:col: error: ..." with its source line and caret.
+    std::string text = e.what();
+    while (!text.empty() && text.back() == '\n')
+    {
+      text.pop_back();
+    }
+    throw ModelFileError(text);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(e.what());
+  }
+}
+
+/// A registered model's name or a model file (.hf, .xml).
+ResolvedModel ResolveModel(const std::string& nameOrPath)
+{
+  if (!lang::isModelFile(nameOrPath))
+  {
+    const frep::ModelInfo& info = FindModel(nameOrPath);
+    return { info.name, info.build(), info.boundsLo, info.boundsHi };
+  }
+  lang::ModelFile file = OpenModelFile(nameOrPath);
+  ResolvedModel model{ file.name, std::move(file.model), {}, {} };
+  if (file.bounds)
+  {
+    const auto& b = *file.bounds;
+    model.Lo = { b[0], b[2], b[4] };
+    model.Hi = { b[1], b[3], b[5] };
+    return model;
+  }
+  // No bounds in the file: find them by interval arithmetic, the domain's missing axes flat.
+  const frep::Box search{ { -FileSearchHalfWidth, -FileSearchHalfWidth, -FileSearchHalfWidth },
+    { FileSearchHalfWidth, FileSearchHalfWidth, FileSearchHalfWidth } };
+  const std::vector<double> params(static_cast<std::size_t>(file.parameterCount), 0.0);
+  std::optional<frep::Box> box;
+  try
+  {
+    box = frep::boundingBox(
+      frep::Tape::compile(model.Model.geometry().function()), search, 6, 0.0, params);
+  }
+  catch (const std::invalid_argument&)
+  {
+    box = search; // a model whose parameters are needed to bound it: sample the whole box
+  }
+  const frep::Box b = box ? *box : search;
+  const std::uint8_t axes = frep::domainAxes(model.Model.geometry().domain());
+  for (int a = 0; a < 3; ++a)
+  {
+    const bool used = axes & (1u << a);
+    // A little margin, so the surface does not touch the grid's border.
+    const double pad = 0.02 * (b.hi[a] - b.lo[a]);
+    model.Lo[a] = used ? b.lo[a] - pad : 0.0;
+    model.Hi[a] = used ? b.hi[a] + pad : 0.0;
+  }
+  return model;
+}
+
 struct EvalOptions
 {
   std::string Model;
@@ -449,13 +540,13 @@ struct EvalOptions
 
 int RunEval(const EvalOptions& o)
 {
-  const frep::ModelInfo& info = FindModel(o.Model);
+  const ResolvedModel model = ResolveModel(o.Model);
   const std::vector<double> at =
     ParseNumbers(o.At, "--at", { "x", "y", "z", "t" }, 3, 4, "x,y,z or x,y,z,t");
   const std::array<double, 4> p{ at[0], at[1], at[2], at.size() > 3 ? at[3] : 0.0 };
   const std::vector<double> params = ParseParameters(o.Params);
 
-  const frep::Hypervolume hv = info.build();
+  const frep::Hypervolume& hv = model.Model;
   std::vector<double> attributes(hv.attributeComponentCount());
   double value = 0;
   std::unique_ptr<frep::HypervolumeEvaluator> evaluator;
@@ -479,7 +570,7 @@ int RunEval(const EvalOptions& o)
   const std::array<double, 3> normal = frep::outwardNormal(vg);
 
   nlohmann::ordered_json out;
-  out["model"] = info.name;
+  out["model"] = model.Name;
   out["point"] = p;
   out["value"] = value;
   out["gradient"] = vg.gradient;
@@ -568,21 +659,6 @@ void AttachBoundaryAttributes(vtkPolyData* surface, const frep::Hypervolume& hv,
   }
 }
 
-/// A model ready to sample: its hypervolume and a box that holds it.
-struct ResolvedModel
-{
-  std::string Name;
-  frep::Hypervolume Model;
-  std::array<double, 3> Lo;
-  std::array<double, 3> Hi;
-};
-
-ResolvedModel ResolveModel(const std::string& name)
-{
-  const frep::ModelInfo& info = FindModel(name);
-  return { info.name, info.build(), info.boundsLo, info.boundsHi };
-}
-
 /// Options shared by the commands that sample a model on a grid (sample, mesh).
 struct GridCommandOptions
 {
@@ -598,7 +674,8 @@ struct GridCommandOptions
   void AddTo(CLI::App* command, std::int64_t defaultResolution)
   {
     this->Resolution = defaultResolution;
-    command->add_option("model", this->Model, "Model name (see `ictk models`)")->required();
+    command->add_option("model", this->Model, "Model name (see `ictk models`) or a .hf / .xml file")
+      ->required();
     CLI::Option* resolution = command->add_option("--resolution", this->Resolution,
       "Points per axis (default " + std::to_string(defaultResolution) + ")");
     CLI::Option* dims = command->add_option("--dims", this->Dims, "Points per axis: NX,NY,NZ");
@@ -933,6 +1010,43 @@ int RunMesh(const GridCommandOptions& o)
   return 0;
 }
 
+struct ConvertOptions
+{
+  std::string Input;
+  std::string Output;
+};
+
+/// Translates between model files (.hf, .xml); a registered model can be exported too.
+int RunConvert(const ConvertOptions& o)
+{
+  if (!lang::isModelFile(o.Output))
+  {
+    throw UserError("convert: '" + o.Output + "' is not a .hf or .xml file");
+  }
+  auto open = [&]() -> lang::ModelFile
+  {
+    if (lang::isModelFile(o.Input))
+    {
+      return OpenModelFile(o.Input);
+    }
+    const frep::ModelInfo& info = FindModel(o.Input);
+    return { info.name, 0, info.build(),
+      std::array<double, 6>{ info.boundsLo[0], info.boundsHi[0], info.boundsLo[1], info.boundsHi[1],
+        info.boundsLo[2], info.boundsHi[2] } };
+  };
+  const lang::ModelFile model = open();
+  try
+  {
+    lang::saveModelFile(model, o.Output);
+  }
+  catch (const std::exception& e)
+  {
+    throw UserError(e.what());
+  }
+  std::cout << "wrote " << o.Output << " (model '" << model.name << "')\n";
+  return 0;
+}
+
 int Run(int argc, char** argv)
 {
   CLI::App app{ "ICTK: Implicit Complex ToolKit command-line tool", "ictk" };
@@ -946,7 +1060,9 @@ int Run(int argc, char** argv)
 
   EvalOptions evalOptions;
   CLI::App* eval = app.add_subcommand("eval", "Evaluate a model at a point");
-  eval->add_option("model", evalOptions.Model, "Model name (see `ictk models`)")->required();
+  eval
+    ->add_option("model", evalOptions.Model, "Model name (see `ictk models`) or a .hf / .xml file")
+    ->required();
   eval->add_option("--at", evalOptions.At, "The point: x,y,z or x,y,z,t")->required();
   eval->add_option("--params", evalOptions.Params, "Model parameters: p1,p2,...");
   eval->add_flag("--json", evalOptions.Json,
@@ -960,6 +1076,13 @@ int Run(int argc, char** argv)
     "--double", sampleOptions.Double, "Write double-precision arrays (default float)");
   sample->add_option("--surface", sampleOptions.Surface,
     "Also extract the surface f = 0 (Flying Edges) into this .vtp, .stl, .ply or .obj");
+
+  ConvertOptions convertOptions;
+  CLI::App* convert =
+    app.add_subcommand("convert", "Translate a model between HyperFun (.hf) and FRep XML (.xml)");
+  convert->add_option("input", convertOptions.Input, "A .hf or .xml file, or a registered model")
+    ->required();
+  convert->add_option("output", convertOptions.Output, "The .hf or .xml file to write")->required();
 
   GridCommandOptions meshOptions;
   CLI::App* mesh = app.add_subcommand("mesh",
@@ -1001,6 +1124,10 @@ int Run(int argc, char** argv)
   {
     return RunMesh(meshOptions);
   }
+  if (*convert)
+  {
+    return RunConvert(convertOptions);
+  }
   return RunSample(sampleOptions);
 }
 
@@ -1011,6 +1138,10 @@ int main(int argc, char** argv)
   try
   {
     return Run(argc, argv);
+  }
+  catch (const ModelFileError& e)
+  {
+    std::cerr << e.what() << "\n";
   }
   catch (const std::bad_alloc&)
   {

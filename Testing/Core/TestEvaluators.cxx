@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Agreement of the four evaluators over random expression trees, tape simplification, sampling.
+#include "FRep/Bounds.h"
 #include "FRep/Evaluators.h"
 #include "FRep/Hypervolume.h"
 #include "FRep/Sampling.h"
@@ -479,4 +480,33 @@ TEST(Sampling, HypervolumeInOnePassMatchesPointEvaluation)
       }
   EXPECT_GT(defaults, n / 4); // both defaults are exercised (half the box has x < 0)
   EXPECT_THROW(sampleGrid(hv, grid, f.data(), { d.data() }), std::invalid_argument);
+}
+
+TEST(Bounds, IntervalBoundingBoxHoldsTheSolid)
+{
+  // A ball of radius 0.5 at (1, -2, 0.25): the box found in [-10, 10]^3 at depth 7 (cells of
+  // 20/128 = 0.156) holds [0.5, 1.5] x [-2.5, -1.5] x [-0.25, 0.75] and exceeds it by at most
+  // two cells per side.
+  const Expr f =
+    Expr(0.25) - square(Expr::x() - 1.0) - square(Expr::y() + 2.0) - square(Expr::z() - 0.25);
+  const auto box = boundingBox(Tape::compile(f), { { -10, -10, -10 }, { 10, 10, 10 } }, 7);
+  ASSERT_TRUE(box.has_value());
+  const std::array<double, 3> lo{ 0.5, -2.5, -0.25 }, hi{ 1.5, -1.5, 0.75 };
+  for (int a = 0; a < 3; ++a)
+  {
+    EXPECT_LE(box->lo[a], lo[a]);
+    EXPECT_GE(box->hi[a], hi[a]);
+    EXPECT_GT(box->lo[a], lo[a] - 2 * 0.15625);
+    EXPECT_LT(box->hi[a], hi[a] + 2 * 0.15625);
+  }
+  // Nothing inside: no box. An infinite cylinder along z: the search box's z extent.
+  EXPECT_FALSE(
+    boundingBox(Tape::compile(Expr(-1.0) - square(Expr::x())), { { -1, -1, -1 }, { 1, 1, 1 } })
+      .has_value());
+  const auto cyl = boundingBox(Tape::compile(Expr(1.0) - square(Expr::x()) - square(Expr::y())),
+    { { -10, -10, -10 }, { 10, 10, 10 } }, 6);
+  ASSERT_TRUE(cyl.has_value());
+  EXPECT_EQ(cyl->lo[2], -10.0);
+  EXPECT_EQ(cyl->hi[2], 10.0);
+  EXPECT_LT(cyl->hi[0], 2.0);
 }

@@ -221,6 +221,62 @@ def check_mesh_formats(ictk, work):
     no_leftovers(work)
 
 
+def check_model_files(ictk, work):
+    """Model files (.hf, .xml) everywhere a model name goes; convert between them; a malformed
+    file gives file:line:col diagnostics with a caret and exit code 2."""
+    data = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "Data", "Models")
+    sphere = os.path.join(data, "sphere.hf")
+    # sphere.hf: 4 - (x - 1)^2 - y^2 - z^2.
+    p = run(ictk, ["eval", sphere, "--at", "0,0,0", "--json"])
+    out = json.loads(p.stdout)
+    near(out["value"], 3.0, 1e-15, "value of sphere.hf at the origin")
+    near(out["gradient"][0], 2.0, 1e-15, "d/dx of sphere.hf at the origin")
+    # .hf -> .xml -> .hf: the same values.
+    xml, hf = os.path.join(work, "bracket.xml"), os.path.join(work, "bracket.hf")
+    run(ictk, ["convert", os.path.join(data, "bracket.hf"), xml])
+    run(ictk, ["convert", xml, hf])
+    for point in ("0.7,0,0", "0.5,0,1", "0,0,0", "1.3,-0.2,0.4"):
+        values = [float(run(ictk, ["eval", path, "--at", point]).stdout)
+                  for path in (os.path.join(data, "bracket.hf"), xml, hf)]
+        if len(set(values)) != 1:
+            sys.exit(f"FAIL: values at {point} differ across .hf/.xml/.hf: {values}")
+    # A registered model exported as HyperFun reads back to the same field.
+    walnut = os.path.join(work, "walnut.hf")
+    run(ictk, ["convert", "walnut", walnut])
+    for point in ("0.9,0,0", "0.2,0.3,-0.1"):
+        a = float(run(ictk, ["eval", "walnut", "--at", point]).stdout)
+        b = float(run(ictk, ["eval", walnut, "--at", point]).stdout)
+        if a != b:
+            sys.exit(f"FAIL: walnut {a} != walnut.hf {b} at {point}")
+    # Meshing a file: bounds found by interval arithmetic; the ball of radius 2 has area 16 pi.
+    stl = os.path.join(work, "sphere.stl")
+    run(ictk, ["mesh", sphere, "-o", stl, "--resolution", "80"])
+    import vtk
+    reader = vtk.vtkSTLReader()
+    reader.SetFileName(stl)
+    mass = vtk.vtkMassProperties()
+    mass.SetInputConnection(reader.GetOutputPort())
+    mass.Update()
+    near(mass.GetSurfaceArea(), 16 * math.pi, 0.01 * 16 * math.pi, "area of sphere.hf")
+    # Diagnostics.
+    bad = os.path.join(work, "bad.hf")
+    with open(bad, "w") as f:
+        f.write("m(x[3], a[1])\n{\n  m = 1 + ;\n  q = 2 *;\n}\n")
+    p = run(ictk, ["eval", bad, "--at", "0,0,0"], check=False)
+    if p.returncode != 2:
+        sys.exit(f"FAIL: a malformed file exited {p.returncode}")
+    lines = p.stderr.splitlines()
+    if not lines or not re.match(re.escape(bad) + r":3:11: error: ", lines[0]) or lines[2] != " " * 10 + "^":
+        sys.exit(f"FAIL: diagnostics:\n{p.stderr}")
+    if not any(re.match(re.escape(bad) + r":4:10: error: ", l) for l in lines):
+        sys.exit(f"FAIL: the second error is not reported:\n{p.stderr}")
+    missing = os.path.join(work, "no-such.hf")
+    p = run(ictk, ["eval", missing, "--at", "0,0,0"], check=False)
+    if p.returncode != 2 or not p.stderr.startswith(missing + ": error: cannot open"):
+        sys.exit(f"FAIL: a missing file: exit {p.returncode}\n{p.stderr}")
+    no_leftovers(work)
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -237,6 +293,7 @@ def main():
         "sample-walnut": check_sample_walnut,
         "sample-disk2d": check_sample_disk2d,
         "mesh-formats": check_mesh_formats,
+        "model-files": check_model_files,
     }
     if check == "expect-error":
         if len(rest) < 2 or rest[1] != "--":

@@ -1,0 +1,1271 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The FRep XML interchange format; docs/frep-xml.md describes it.
+//
+// Writing is done by hand rather than through a pugixml DOM: the output is then deterministic to
+// the byte, and linear in the DAG size. Reading uses pugixml (whose parser is iterative, so deep
+// documents cannot overflow the stack) and walks the document with an explicit stack for the same
+// reason.
+#include "Lang/FRepXml.h"
+
+#include <pugixml.hpp>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace ictk::lang
+{
+
+namespace
+{
+using frep::Axis;
+using frep::Domain;
+using frep::Expr;
+using frep::Opcode;
+
+// Writer nesting budget: a sub-expression deeper than this moves to <defs> and is referenced, so
+// that a long chain (a union of thousands of shapes) still reads back under Limits::maxNesting.
+constexpr int kMaxInlineDepth = 48;
+// Parameter slots above this are refused: the evaluators allocate one value per slot.
+constexpr std::uint32_t kMaxParameterSlot = 1u << 20;
+// Attribute component counts above this are refused (a 256 x 256 tensor is already absurd).
+constexpr std::uint64_t kMaxComponents = 1u << 16;
+
+std::string formatNumber(double v)
+{
+  // 17 significant digits: every double reads back exactly. to_chars ignores the C locale.
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 17);
+  return std::string(buf, r.ptr);
+}
+
+std::string numberList(const std::vector<double>& values)
+{
+  std::string s;
+  for (std::size_t i = 0; i < values.size(); ++i)
+  {
+    if (i)
+    {
+      s += ' ';
+    }
+    s += formatNumber(values[i]);
+  }
+  return s;
+}
+
+std::string escapeAttribute(const std::string& value, const char* what)
+{
+  std::string s;
+  s.reserve(value.size());
+  for (char c : value)
+  {
+    switch (c)
+    {
+      case '&':
+        s += "&amp;";
+        break;
+      case '<':
+        s += "&lt;";
+        break;
+      case '>':
+        s += "&gt;";
+        break;
+      case '"':
+        s += "&quot;";
+        break;
+      // Character references, because a parser normalises literal white space in attributes.
+      case '\n':
+        s += "&#10;";
+        break;
+      case '\r':
+        s += "&#13;";
+        break;
+      case '\t':
+        s += "&#9;";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20)
+        {
+          throw std::invalid_argument(std::string("writeFRepXml: the ") + what +
+            " contains a control character, which XML 1.0 cannot carry");
+        }
+        s += c;
+    }
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writer
+
+class XmlWriter
+{
+public:
+  std::string write(const frep::Hypervolume& hv, const std::string& name, int parameterCount,
+    const std::optional<std::array<double, 6>>& bounds)
+  {
+    std::vector<Expr> roots;
+    roots.push_back(hv.geometry().function());
+    for (const frep::Attribute& a : hv.attributes())
+    {
+      roots.push_back(a.partition);
+      roots.insert(roots.end(), a.components.begin(), a.components.end());
+    }
+    analyse(roots);
+    // The a parameter array must cover every slot the model reads.
+    parameterCount = std::max(parameterCount, static_cast<int>(maxSlot_ + 1));
+
+    out_ += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    out_ += "<frep version=\"1\" name=\"" + escapeAttribute(name, "model name") +
+      "\" parameters=\"" + std::to_string(parameterCount) + "\">\n";
+    if (bounds)
+    {
+      const auto& b = *bounds;
+      out_ += "  <bounds lo=\"" + numberList({ b[0], b[2], b[4] }) + "\" hi=\"" +
+        numberList({ b[1], b[3], b[5] }) + "\"/>\n";
+    }
+    out_ += std::string("  <geometry domain=\"") + frep::domainName(hv.geometry().domain()) +
+      "\" threshold=\"" + formatNumber(hv.threshold()) + "\">\n";
+    if (!spilledOrder_.empty())
+    {
+      out_ += "    <defs>\n";
+      for (const Expr& e : spilledOrder_)
+      {
+        writeExpr(e, 3, true);
+      }
+      out_ += "    </defs>\n";
+    }
+    writeExpr(hv.geometry().function(), 2, false);
+    out_ += "  </geometry>\n";
+    for (const frep::Attribute& a : hv.attributes())
+    {
+      out_ += "  <attribute name=\"" + escapeAttribute(a.name, "attribute name") +
+        "\" components=\"" + std::to_string(a.components.size()) + "\" tensorRows=\"" +
+        std::to_string(a.tensorRows) + "\">\n";
+      out_ += "    <partition>\n";
+      writeExpr(a.partition, 3, false);
+      out_ += "    </partition>\n";
+      for (const Expr& c : a.components)
+      {
+        out_ += "    <component>\n";
+        writeExpr(c, 3, false);
+        out_ += "    </component>\n";
+      }
+      out_ += "    <inside>" + numberList(a.insideDefault) + "</inside>\n";
+      out_ += "    <outside>" + numberList(a.outsideDefault) + "</outside>\n";
+      out_ += "  </attribute>\n";
+    }
+    out_ += "</frep>\n";
+    return std::move(out_);
+  }
+
+private:
+  // Counts the parents of every node over all roots, finds the nodes that must move to <defs>
+  // (in post-order, so that each is defined before use) and the largest parameter slot.
+  void analyse(const std::vector<Expr>& roots)
+  {
+    std::unordered_map<const frep::Node*, int> depth;
+    std::unordered_set<const frep::Node*> done;
+    for (const Expr& root : roots)
+    {
+      ++uses_[root.id()];
+      if (done.count(root.id()))
+      {
+        continue;
+      }
+      std::vector<std::pair<Expr, int>> stack;
+      stack.emplace_back(root, 0);
+      while (!stack.empty())
+      {
+        auto& [e, next] = stack.back();
+        if (next < e.arity())
+        {
+          Expr c = e.child(next++);
+          ++uses_[c.id()];
+          if (!done.count(c.id()))
+          {
+            done.insert(c.id());
+            stack.emplace_back(std::move(c), 0);
+          }
+          continue;
+        }
+        done.insert(e.id());
+        int d = 1;
+        for (int i = 0; i < e.arity(); ++i)
+        {
+          const frep::Node* c = e.child(i).id();
+          d = std::max(d, 1 + (spilled_.count(c) ? 1 : depth.at(c)));
+        }
+        if (e.opcode() == Opcode::Parameter)
+        {
+          maxSlot_ = std::max<long long>(maxSlot_, e.parameterSlot());
+        }
+        if (d > kMaxInlineDepth)
+        {
+          spilled_.insert(e.id());
+          spilledOrder_.push_back(e);
+        }
+        depth[e.id()] = d;
+        stack.pop_back();
+      }
+    }
+  }
+
+  void indent(int level) { out_.append(static_cast<std::size_t>(level) * 2, ' '); }
+
+  // Recursion is bounded by kMaxInlineDepth thanks to the spilling above.
+  void writeExpr(const Expr& e, int level, bool define)
+  {
+    indent(level);
+    switch (e.opcode())
+    {
+      case Opcode::Constant:
+        out_ += "<const value=\"" + formatNumber(e.constantValue()) + "\"/>\n";
+        return;
+      case Opcode::Variable:
+        out_ += std::string("<var axis=\"") + frep::axisName(e.axis()) + "\"/>\n";
+        return;
+      case Opcode::Parameter:
+        out_ += "<param slot=\"" + std::to_string(e.parameterSlot()) + "\"/>\n";
+        return;
+      default:
+        break;
+    }
+    // A spilled node is defined in <defs> (in post-order) before anything refers to it, so it
+    // is always found here when not being defined.
+    auto written = ids_.find(e.id());
+    if (written != ids_.end())
+    {
+      out_ += "<ref id=\"" + written->second + "\"/>\n";
+      return;
+    }
+    out_ += '<';
+    out_ += frep::opcodeName(e.opcode());
+    if (define || uses_.at(e.id()) > 1)
+    {
+      std::string id = "n" + std::to_string(nextId_++);
+      out_ += " id=\"" + id + "\"";
+      ids_.emplace(e.id(), std::move(id));
+    }
+    out_ += ">\n";
+    for (int i = 0; i < e.arity(); ++i)
+    {
+      writeExpr(e.child(i), level + 1, false);
+    }
+    indent(level);
+    out_ += "</";
+    out_ += frep::opcodeName(e.opcode());
+    out_ += ">\n";
+  }
+
+  std::string out_;
+  std::unordered_map<const frep::Node*, int> uses_;
+  std::unordered_set<const frep::Node*> spilled_;
+  std::vector<Expr> spilledOrder_;
+  std::unordered_map<const frep::Node*, std::string> ids_;
+  int nextId_ = 1;
+  long long maxSlot_ = -1;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Reader
+
+// Thrown internally to stop reading once the diagnostics are complete (or too many).
+struct StopReading
+{};
+
+bool isXmlSpace(char c)
+{
+  return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
+class XmlReader
+{
+public:
+  XmlReader(const std::string& text, const std::string& fileName, const Limits& limits)
+    : text_(text)
+    , file_(fileName)
+    , limits_(limits)
+  {
+  }
+
+private:
+  // ----- diagnostics
+
+  SourceLocation locate(std::ptrdiff_t offset, std::string* sourceLine) const
+  {
+    SourceLocation where;
+    where.file = file_;
+    if (offset < 0)
+    {
+      return where;
+    }
+    const auto off = std::min(static_cast<std::size_t>(offset), text_.size());
+    int line = 1;
+    std::size_t lineStart = 0;
+    for (std::size_t i = 0; i < off; ++i)
+    {
+      if (text_[i] == '\n')
+      {
+        ++line;
+        lineStart = i + 1;
+      }
+    }
+    where.line = line;
+    where.column = static_cast<int>(off - lineStart) + 1;
+    std::size_t lineEnd = text_.find('\n', lineStart);
+    if (lineEnd == std::string::npos)
+    {
+      lineEnd = text_.size();
+    }
+    if (lineEnd > lineStart && text_[lineEnd - 1] == '\r')
+    {
+      --lineEnd;
+    }
+    // A minified document is one huge line: printing it under the message helps nobody.
+    if (lineEnd - lineStart <= 512)
+    {
+      *sourceLine = text_.substr(lineStart, lineEnd - lineStart);
+    }
+    return where;
+  }
+
+  // Offset of an element's '<' (pugixml reports the offset of its name).
+  std::ptrdiff_t offsetOf(const pugi::xml_node& n) const
+  {
+    std::ptrdiff_t off = n.offset_debug();
+    if (off > 0 && static_cast<std::size_t>(off) <= text_.size() && text_[off - 1] == '<')
+    {
+      --off;
+    }
+    return off;
+  }
+
+  void error(std::ptrdiff_t offset, std::string message)
+  {
+    Diagnostic d;
+    d.where = locate(offset, &d.sourceLine);
+    d.message = std::move(message);
+    diagnostics_.push_back(std::move(d));
+    if (diagnostics_.size() >= std::max<std::size_t>(limits_.maxDiagnostics, 1))
+    {
+      throw StopReading{};
+    }
+  }
+  void error(const pugi::xml_node& n, std::string message)
+  {
+    error(offsetOf(n), std::move(message));
+  }
+  [[noreturn]] void fatal(const pugi::xml_node& n, std::string message)
+  {
+    error(n, std::move(message));
+    throw StopReading{};
+  }
+
+  // ----- values
+
+  static std::string tag(const pugi::xml_node& n) { return std::string("<") + n.name() + ">"; }
+
+  std::optional<double> parseNumber(const char* s) const
+  {
+    const char* end = s + std::strlen(s);
+    double v = 0;
+    auto r = std::from_chars(s, end, v);
+    if (r.ec != std::errc() || r.ptr != end || s == end)
+    {
+      return std::nullopt;
+    }
+    return v;
+  }
+
+  template <typename T>
+  std::optional<T> parseInteger(const char* s) const
+  {
+    const char* end = s + std::strlen(s);
+    T v = 0;
+    auto r = std::from_chars(s, end, v);
+    if (r.ec != std::errc() || r.ptr != end || s == end)
+    {
+      return std::nullopt;
+    }
+    return v;
+  }
+
+  std::optional<std::vector<double>> parseNumberList(const char* s) const
+  {
+    std::vector<double> values;
+    const std::string text(s);
+    std::size_t i = 0;
+    while (true)
+    {
+      while (i < text.size() && isXmlSpace(text[i]))
+      {
+        ++i;
+      }
+      if (i == text.size())
+      {
+        break;
+      }
+      std::size_t j = i;
+      while (j < text.size() && !isXmlSpace(text[j]))
+      {
+        ++j;
+      }
+      auto v = parseNumber(text.substr(i, j - i).c_str());
+      if (!v)
+      {
+        return std::nullopt;
+      }
+      values.push_back(*v);
+      i = j;
+    }
+    return values;
+  }
+
+  // Reports attributes other than `allowed`.
+  void checkAttributes(const pugi::xml_node& n, std::initializer_list<const char*> allowed)
+  {
+    for (const pugi::xml_attribute& a : n.attributes())
+    {
+      bool ok = false;
+      for (const char* name : allowed)
+      {
+        ok = ok || std::strcmp(a.name(), name) == 0;
+      }
+      if (!ok)
+      {
+        error(n, "unknown attribute '" + std::string(a.name()) + "' on " + tag(n));
+      }
+    }
+  }
+
+  bool requireAttribute(const pugi::xml_node& n, const char* name)
+  {
+    if (!n.attribute(name))
+    {
+      error(n, tag(n) + " needs the attribute '" + name + "'");
+      return false;
+    }
+    return true;
+  }
+
+  // Text that is not white space (pugixml drops white-space-only text already).
+  void rejectText(const pugi::xml_node& child, const pugi::xml_node& parent)
+  {
+    error(child, "unexpected text in " + tag(parent));
+  }
+
+  // ----- document
+
+  void readDocument(FRepXmlDocument& result)
+  {
+    if (text_.size() > limits_.maxFileBytes)
+    {
+      error(-1,
+        "the file has " + std::to_string(text_.size()) + " bytes, more than the limit of " +
+          std::to_string(limits_.maxFileBytes));
+      throw StopReading{};
+    }
+    pugi::xml_document doc;
+    const pugi::xml_parse_result parsed =
+      doc.load_buffer(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
+    if (!parsed)
+    {
+      error(parsed.offset, std::string("malformed XML: ") + parsed.description());
+      throw StopReading{};
+    }
+    pugi::xml_node root;
+    for (pugi::xml_node n : doc.children())
+    {
+      if (n.type() == pugi::node_element)
+      {
+        if (root)
+        {
+          fatal(n, "a second top-level element " + tag(n) + " (the document is one <frep>)");
+        }
+        root = n;
+      }
+      else if (n.type() == pugi::node_pcdata || n.type() == pugi::node_cdata)
+      {
+        fatal(n, "text outside the <frep> element");
+      }
+    }
+    if (!root)
+    {
+      error(0, "no <frep> element");
+      throw StopReading{};
+    }
+    if (std::strcmp(root.name(), "frep") != 0)
+    {
+      fatal(root, "the top-level element is " + tag(root) + ", not <frep>");
+    }
+    checkAttributes(root, { "version", "name", "parameters" });
+    if (requireAttribute(root, "version") &&
+      std::strcmp(root.attribute("version").value(), "1") != 0)
+    {
+      fatal(root,
+        "unsupported FRep XML version '" + std::string(root.attribute("version").value()) +
+          "' (this reader knows version 1)");
+    }
+    result.name = root.attribute("name").value();
+    int declaredParameters = 0;
+    if (pugi::xml_attribute p = root.attribute("parameters"))
+    {
+      auto v = parseInteger<std::uint32_t>(p.value());
+      if (!v || *v > kMaxParameterSlot)
+      {
+        error(root, "bad parameter count '" + std::string(p.value()) + "'");
+      }
+      else
+      {
+        declaredParameters = static_cast<int>(*v);
+      }
+    }
+
+    pugi::xml_node geometry;
+    for (pugi::xml_node n : root.children())
+    {
+      if (n.type() == pugi::node_pcdata || n.type() == pugi::node_cdata)
+      {
+        rejectText(n, root);
+        continue;
+      }
+      if (n.type() != pugi::node_element)
+      {
+        continue;
+      }
+      const std::string name = n.name();
+      if (name == "bounds")
+      {
+        if (result.bounds)
+        {
+          error(n, "a second <bounds>");
+        }
+        readBounds(n, result);
+      }
+      else if (name == "geometry")
+      {
+        if (geometry)
+        {
+          error(n, "a second <geometry>");
+          continue;
+        }
+        geometry = n;
+        readGeometry(n, result);
+      }
+      else if (name == "attribute")
+      {
+        if (!geometry)
+        {
+          error(n, "<attribute> before <geometry> (its domain is the geometry's)");
+          continue;
+        }
+        readAttribute(n, result);
+      }
+      else
+      {
+        error(n, "unknown element " + tag(n) + " in <frep>");
+      }
+    }
+    if (!geometry)
+    {
+      error(root, "<frep> has no <geometry>");
+    }
+    if (maxSlot_ >= declaredParameters && root.attribute("parameters") && diagnostics_.empty())
+    {
+      error(root,
+        "the model uses parameter slot " + std::to_string(maxSlot_) + " but declares " +
+          std::to_string(declaredParameters) + " parameter(s)");
+    }
+    result.parameterCount = std::max<int>(declaredParameters, static_cast<int>(maxSlot_ + 1));
+  }
+
+  void readBounds(const pugi::xml_node& n, FRepXmlDocument& result)
+  {
+    checkAttributes(n, { "lo", "hi" });
+    expectEmpty(n);
+    if (!requireAttribute(n, "lo") || !requireAttribute(n, "hi"))
+    {
+      return;
+    }
+    auto lo = parseNumberList(n.attribute("lo").value());
+    auto hi = parseNumberList(n.attribute("hi").value());
+    if (!lo || !hi || lo->size() != 3 || hi->size() != 3)
+    {
+      error(n, "<bounds> needs three numbers in 'lo' and three in 'hi'");
+      return;
+    }
+    std::array<double, 6> b{};
+    for (int i = 0; i < 3; ++i)
+    {
+      if (!std::isfinite((*lo)[i]) || !std::isfinite((*hi)[i]) || (*lo)[i] > (*hi)[i])
+      {
+        error(n, "<bounds> needs finite numbers with lo <= hi on every axis");
+        return;
+      }
+      b[2 * i] = (*lo)[i];
+      b[2 * i + 1] = (*hi)[i];
+    }
+    result.bounds = b;
+  }
+
+  void expectEmpty(const pugi::xml_node& n)
+  {
+    for (pugi::xml_node c : n.children())
+    {
+      if (c.type() == pugi::node_element)
+      {
+        error(c, tag(n) + " takes no child element, found " + tag(c));
+      }
+      else if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
+      {
+        rejectText(c, n);
+      }
+    }
+  }
+
+  void readGeometry(const pugi::xml_node& n, FRepXmlDocument& result)
+  {
+    checkAttributes(n, { "domain", "threshold" });
+    domain_ = Domain::XYZ;
+    if (requireAttribute(n, "domain"))
+    {
+      if (auto d = frep::domainFromName(n.attribute("domain").value()))
+      {
+        domain_ = *d;
+      }
+      else
+      {
+        error(n,
+          "unknown domain '" + std::string(n.attribute("domain").value()) +
+            "' (X, T, XY, XT, XYZ, XYT or XYZT)");
+      }
+    }
+    double threshold = 0;
+    if (pugi::xml_attribute t = n.attribute("threshold"))
+    {
+      auto v = parseNumber(t.value());
+      if (!v || !std::isfinite(*v))
+      {
+        error(n, "bad threshold '" + std::string(t.value()) + "' (a finite number)");
+      }
+      else
+      {
+        threshold = *v;
+      }
+    }
+    std::optional<Expr> f;
+    bool first = true;
+    for (pugi::xml_node c : n.children())
+    {
+      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
+      {
+        rejectText(c, n);
+        continue;
+      }
+      if (c.type() != pugi::node_element)
+      {
+        continue;
+      }
+      if (std::strcmp(c.name(), "defs") == 0)
+      {
+        if (!first)
+        {
+          error(c, "<defs> must come first in <geometry>");
+        }
+        readDefs(c);
+      }
+      else if (f)
+      {
+        error(c, "<geometry> holds one expression; found another, " + tag(c));
+      }
+      else
+      {
+        f = readExpr(c, 3);
+      }
+      first = false;
+    }
+    if (!f)
+    {
+      error(n, "<geometry> has no expression");
+      return;
+    }
+    try
+    {
+      result.model.emplace(frep::Shape(*f, domain_), threshold);
+    }
+    catch (const std::exception& e)
+    {
+      // Only reachable after an error was reported (the domain check is done per <var>).
+      error(n, e.what());
+    }
+  }
+
+  void readDefs(const pugi::xml_node& n)
+  {
+    checkAttributes(n, {});
+    for (pugi::xml_node c : n.children())
+    {
+      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
+      {
+        rejectText(c, n);
+        continue;
+      }
+      if (c.type() != pugi::node_element)
+      {
+        continue;
+      }
+      if (!c.attribute("id"))
+      {
+        error(c, "a definition in <defs> needs an 'id'");
+      }
+      readExpr(c, 4);
+    }
+  }
+
+  // <partition> and <component>: exactly one expression.
+  std::optional<Expr> readSlot(const pugi::xml_node& n)
+  {
+    checkAttributes(n, {});
+    std::optional<Expr> e;
+    for (pugi::xml_node c : n.children())
+    {
+      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
+      {
+        rejectText(c, n);
+        continue;
+      }
+      if (c.type() != pugi::node_element)
+      {
+        continue;
+      }
+      if (e)
+      {
+        error(c, tag(n) + " holds one expression; found another, " + tag(c));
+        continue;
+      }
+      e = readExpr(c, 4);
+    }
+    if (!e)
+    {
+      error(n, tag(n) + " has no expression");
+    }
+    return e;
+  }
+
+  void readAttribute(const pugi::xml_node& n, FRepXmlDocument& result)
+  {
+    checkAttributes(n, { "name", "components", "tensorRows" });
+    frep::Attribute a;
+    bool ok = requireAttribute(n, "name") && requireAttribute(n, "components");
+    a.name = n.attribute("name").value();
+    std::uint64_t declared = 0;
+    if (pugi::xml_attribute c = n.attribute("components"))
+    {
+      auto v = parseInteger<std::uint64_t>(c.value());
+      if (!v || *v == 0 || *v > kMaxComponents)
+      {
+        error(n, "bad component count '" + std::string(c.value()) + "'");
+        ok = false;
+      }
+      else
+      {
+        declared = *v;
+      }
+    }
+    if (pugi::xml_attribute r = n.attribute("tensorRows"))
+    {
+      auto v = parseInteger<int>(r.value());
+      if (!v || *v < 0)
+      {
+        error(n, "bad tensorRows '" + std::string(r.value()) + "'");
+        ok = false;
+      }
+      else
+      {
+        a.tensorRows = *v;
+      }
+    }
+    bool havePartition = false, haveInside = false, haveOutside = false;
+    for (pugi::xml_node c : n.children())
+    {
+      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
+      {
+        rejectText(c, n);
+        continue;
+      }
+      if (c.type() != pugi::node_element)
+      {
+        continue;
+      }
+      const std::string name = c.name();
+      if (name == "partition")
+      {
+        if (havePartition)
+        {
+          error(c, "a second <partition>");
+        }
+        havePartition = true;
+        if (auto e = readSlot(c))
+        {
+          a.partition = *e;
+        }
+        else
+        {
+          ok = false;
+        }
+      }
+      else if (name == "component")
+      {
+        if (auto e = readSlot(c))
+        {
+          a.components.push_back(*e);
+        }
+        else
+        {
+          ok = false;
+        }
+      }
+      else if (name == "inside" || name == "outside")
+      {
+        bool& have = name == "inside" ? haveInside : haveOutside;
+        if (have)
+        {
+          error(c, "a second " + tag(c));
+        }
+        have = true;
+        checkAttributes(c, {});
+        for (pugi::xml_node k : c.children())
+        {
+          if (k.type() == pugi::node_element)
+          {
+            error(k, tag(c) + " holds numbers, not " + tag(k));
+            ok = false;
+          }
+        }
+        auto values = parseNumberList(c.text().get());
+        if (!values)
+        {
+          error(c, "bad number in " + tag(c));
+          ok = false;
+        }
+        else if (values->size() != declared)
+        {
+          error(c,
+            tag(c) + " has " + std::to_string(values->size()) + " value(s) for " +
+              std::to_string(declared) + " component(s)");
+          ok = false;
+        }
+        else
+        {
+          (name == "inside" ? a.insideDefault : a.outsideDefault) = std::move(*values);
+        }
+      }
+      else
+      {
+        error(c, "unknown element " + tag(c) + " in <attribute>");
+        ok = false;
+      }
+    }
+    if (declared && a.components.size() != declared)
+    {
+      error(n,
+        "<attribute> declares " + std::to_string(declared) + " component(s) but has " +
+          std::to_string(a.components.size()));
+      ok = false;
+    }
+    if (!ok || !result.model)
+    {
+      return;
+    }
+    try
+    {
+      result.model->addAttribute(std::move(a));
+    }
+    catch (const std::invalid_argument& e)
+    {
+      error(n, e.what());
+    }
+  }
+
+  // ----- expressions
+
+  struct Frame
+  {
+    pugi::xml_node node;
+    Opcode op = Opcode::Constant;
+    std::vector<Expr> args;
+    pugi::xml_node next; // the next child to look at
+    bool ok = true;
+    std::optional<Expr> value; // set for leaves
+  };
+
+  static std::optional<Opcode> opcodeFromName(const char* name)
+  {
+    for (int i = 0; i < static_cast<int>(Opcode::Count_); ++i)
+    {
+      if (std::strcmp(frep::opcodeName(static_cast<Opcode>(i)), name) == 0)
+      {
+        return static_cast<Opcode>(i);
+      }
+    }
+    return std::nullopt;
+  }
+
+  // Validates one element and, for a leaf, computes its value.
+  Frame open(const pugi::xml_node& n)
+  {
+    Frame f;
+    f.node = n;
+    f.next = n.first_child();
+    if (++nodeCount_ > limits_.maxExpressionNodes)
+    {
+      fatal(n,
+        "the model has more than " + std::to_string(limits_.maxExpressionNodes) +
+          " expression nodes");
+    }
+    if (std::strcmp(n.name(), "ref") == 0)
+    {
+      checkAttributes(n, { "id" });
+      f.value = Expr(0.0);
+      if (requireAttribute(n, "id"))
+      {
+        const std::string id = n.attribute("id").value();
+        auto it = defined_.find(id);
+        if (it != defined_.end())
+        {
+          f.value = it->second;
+        }
+        else
+        {
+          // Forward (or cyclic) or dangling: told apart once the whole document is read.
+          pendingRefs_.emplace_back(id, offsetOf(n));
+        }
+      }
+      expectEmpty(n);
+      return f;
+    }
+    auto op = opcodeFromName(n.name());
+    if (!op)
+    {
+      error(n, "unknown element " + tag(n) + " in an expression");
+      f.value = Expr(0.0);
+      f.ok = false;
+      return f;
+    }
+    f.op = *op;
+    switch (*op)
+    {
+      case Opcode::Constant:
+      {
+        checkAttributes(n, { "value", "id" });
+        f.value = Expr(0.0);
+        if (requireAttribute(n, "value"))
+        {
+          if (auto v = parseNumber(n.attribute("value").value()))
+          {
+            f.value = Expr::constant(*v);
+          }
+          else
+          {
+            error(n, "bad number '" + std::string(n.attribute("value").value()) + "'");
+          }
+        }
+        expectEmpty(n);
+        break;
+      }
+      case Opcode::Variable:
+      {
+        checkAttributes(n, { "axis", "id" });
+        f.value = Expr(0.0);
+        if (requireAttribute(n, "axis"))
+        {
+          const std::string axis = n.attribute("axis").value();
+          std::optional<Axis> a;
+          for (int i = 0; i < frep::AxisCount; ++i)
+          {
+            if (axis == frep::axisName(static_cast<Axis>(i)))
+            {
+              a = static_cast<Axis>(i);
+            }
+          }
+          if (!a)
+          {
+            error(n, "unknown axis '" + axis + "' (x, y, z or t)");
+          }
+          else if (!(frep::domainAxes(domain_) & (1u << static_cast<int>(*a))))
+          {
+            error(
+              n, "coordinate '" + axis + "' is outside the domain " + frep::domainName(domain_));
+          }
+          else
+          {
+            f.value = Expr::variable(*a);
+          }
+        }
+        expectEmpty(n);
+        break;
+      }
+      case Opcode::Parameter:
+      {
+        checkAttributes(n, { "slot", "id" });
+        f.value = Expr(0.0);
+        if (requireAttribute(n, "slot"))
+        {
+          auto slot = parseInteger<std::uint32_t>(n.attribute("slot").value());
+          if (!slot || *slot >= kMaxParameterSlot)
+          {
+            error(n,
+              "bad parameter slot '" + std::string(n.attribute("slot").value()) +
+                "' (an integer from 0 to " + std::to_string(kMaxParameterSlot - 1) + ")");
+          }
+          else
+          {
+            f.value = Expr::parameter(*slot);
+            maxSlot_ = std::max<long long>(maxSlot_, *slot);
+          }
+        }
+        expectEmpty(n);
+        break;
+      }
+      default:
+        checkAttributes(n, { "id" });
+        break;
+    }
+    return f;
+  }
+
+  // Gives a finished element its value and registers its id.
+  Expr close(Frame& f)
+  {
+    Expr value;
+    if (f.value)
+    {
+      value = *f.value;
+    }
+    else
+    {
+      const int arity = frep::opcodeArity(f.op);
+      if (static_cast<int>(f.args.size()) != arity)
+      {
+        error(f.node,
+          tag(f.node) + " takes " + std::to_string(arity) + " operand(s), found " +
+            std::to_string(f.args.size()));
+        f.ok = false;
+      }
+      if (f.ok)
+      {
+        switch (arity)
+        {
+          case 1:
+            value = Expr::make(f.op, f.args[0]);
+            break;
+          case 2:
+            value = Expr::make(f.op, f.args[0], f.args[1]);
+            break;
+          default:
+            value = Expr::make(f.op, f.args[0], f.args[1], f.args[2]);
+            break;
+        }
+      }
+    }
+    if (pugi::xml_attribute id = f.node.attribute("id"); id && std::strcmp(f.node.name(), "ref"))
+    {
+      const std::string name = id.value();
+      if (name.empty())
+      {
+        error(f.node, "empty id");
+      }
+      else if (!defined_.emplace(name, value).second)
+      {
+        error(f.node, "duplicate id '" + name + "'");
+      }
+      else
+      {
+        definedAt_.emplace(name, offsetOf(f.node));
+      }
+    }
+    return value;
+  }
+
+  // Reads the expression rooted at element `root`, which sits at XML depth `depth` (the <frep>
+  // element is depth 1). Iterative, so that nesting is limited by Limits::maxNesting only.
+  Expr readExpr(const pugi::xml_node& root, int depth)
+  {
+    std::vector<Frame> stack;
+    auto push = [&](const pugi::xml_node& n)
+    {
+      if (depth + static_cast<int>(stack.size()) > limits_.maxNesting)
+      {
+        fatal(n, "elements nested deeper than " + std::to_string(limits_.maxNesting));
+      }
+      stack.push_back(open(n));
+    };
+    push(root);
+    Expr result;
+    while (!stack.empty())
+    {
+      Frame& f = stack.back();
+      if (!f.value && f.ok)
+      {
+        // Find the next operand element.
+        pugi::xml_node c = f.next;
+        while (c && c.type() != pugi::node_element)
+        {
+          if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
+          {
+            rejectText(c, f.node);
+          }
+          c = c.next_sibling();
+        }
+        if (c)
+        {
+          f.next = c.next_sibling();
+          push(c);
+          continue;
+        }
+      }
+      Expr value = close(f);
+      stack.pop_back();
+      if (stack.empty())
+      {
+        result = value;
+      }
+      else
+      {
+        stack.back().args.push_back(value);
+      }
+    }
+    return result;
+  }
+
+public:
+  // Called after the document: refs that never resolved.
+  void reportPendingRefs()
+  {
+    for (const auto& [id, offset] : pendingRefs_)
+    {
+      auto at = definedAt_.find(id);
+      if (at != definedAt_.end())
+      {
+        error(offset,
+          "reference to '" + id + "' before its definition (at line " +
+            std::to_string(locate(at->second, &scratch_).line) + ")");
+      }
+      else
+      {
+        error(offset, "reference to an undefined id '" + id + "'");
+      }
+    }
+    pendingRefs_.clear();
+  }
+
+private:
+  const std::string& text_;
+  std::string file_;
+  Limits limits_;
+  std::vector<Diagnostic> diagnostics_;
+  Domain domain_ = Domain::XYZ;
+  std::unordered_map<std::string, Expr> defined_;
+  std::unordered_map<std::string, std::ptrdiff_t> definedAt_;
+  std::vector<std::pair<std::string, std::ptrdiff_t>> pendingRefs_;
+  std::size_t nodeCount_ = 0;
+  long long maxSlot_ = -1;
+  std::string scratch_;
+
+  friend FRepXmlDocument ictk::lang::readFRepXmlDocument(
+    const std::string&, const std::string&, const Limits&);
+};
+
+std::string readWholeFile(const std::string& path, const Limits& limits)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+  {
+    Diagnostic d;
+    d.where.file = path;
+    d.message = "cannot open the file: " + std::string(std::strerror(errno));
+    throw ParseError({ d });
+  }
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (size < 0 || static_cast<std::uint64_t>(size) > limits.maxFileBytes)
+  {
+    Diagnostic d;
+    d.where.file = path;
+    d.message = size < 0 ? std::string("cannot read the file")
+                         : "the file has " + std::to_string(size) +
+        " bytes, more than the limit of " + std::to_string(limits.maxFileBytes);
+    throw ParseError({ d });
+  }
+  std::string text(static_cast<std::size_t>(size), '\0');
+  if (!in.read(text.data(), size))
+  {
+    Diagnostic d;
+    d.where.file = path;
+    d.message = "cannot read the file";
+    throw ParseError({ d });
+  }
+  return text;
+}
+
+} // namespace
+
+FRepXmlDocument readFRepXmlDocument(
+  const std::string& text, const std::string& fileName, const Limits& limits)
+{
+  XmlReader reader(text, fileName, limits);
+  FRepXmlDocument result;
+  std::vector<Diagnostic> diagnostics;
+  try
+  {
+    reader.readDocument(result);
+    reader.reportPendingRefs();
+  }
+  catch (const StopReading&)
+  {
+  }
+  if (!reader.diagnostics_.empty())
+  {
+    std::stable_sort(reader.diagnostics_.begin(), reader.diagnostics_.end(),
+      [](const Diagnostic& a, const Diagnostic& b)
+      {
+        return std::make_pair(a.where.line, a.where.column) <
+          std::make_pair(b.where.line, b.where.column);
+      });
+    throw ParseError(std::move(reader.diagnostics_));
+  }
+  return result;
+}
+
+std::string writeFRepXmlDocument(const frep::Hypervolume& model, const std::string& name,
+  int parameterCount, const std::optional<std::array<double, 6>>& bounds)
+{
+  return XmlWriter().write(model, name, parameterCount, bounds);
+}
+
+frep::Hypervolume readFRepXml(
+  const std::string& text, const std::string& fileName, const Limits& limits)
+{
+  return std::move(*readFRepXmlDocument(text, fileName, limits).model);
+}
+
+frep::Hypervolume readFRepXmlFile(const std::string& path, const Limits& limits)
+{
+  return readFRepXml(readWholeFile(path, limits), path, limits);
+}
+
+std::string writeFRepXml(const frep::Hypervolume& model, const std::string& name)
+{
+  return writeFRepXmlDocument(model, name, 0, std::nullopt);
+}
+
+} // namespace ictk::lang

@@ -1,0 +1,242 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Model files by extension. Bounds are {xmin, xmax, ymin, ymax, zmin, zmax} (VTK's order); only
+// FRep XML stores them.
+#include "Lang/ModelFile.h"
+
+#include "Lang/FRepXml.h"
+#include "Lang/HyperFun.h"
+
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <system_error>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace ictk::lang
+{
+
+namespace
+{
+enum class Format
+{
+  Unknown,
+  HyperFun,
+  Xml
+};
+
+Format formatOf(const std::string& path)
+{
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext)
+  {
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  if (ext == ".hf")
+  {
+    return Format::HyperFun;
+  }
+  if (ext == ".xml")
+  {
+    return Format::Xml;
+  }
+  return Format::Unknown;
+}
+
+[[noreturn]] void unknownExtension(const std::string& path)
+{
+  throw std::invalid_argument(
+    "'" + path + "' is not a model file: the extension must be .hf (HyperFun) or .xml (FRep XML)");
+}
+
+// A HyperFun body name made from any model name: letters, digits and '_', starting with a letter.
+std::string hyperFunName(const std::string& name)
+{
+  std::string s;
+  for (char c : name)
+  {
+    const auto u = static_cast<unsigned char>(c);
+    s += (u < 0x80 && (std::isalnum(u) || c == '_')) ? c : '_';
+  }
+  if (s.empty() || !std::isalpha(static_cast<unsigned char>(s[0])))
+  {
+    s = "model_" + s;
+  }
+  if (s.size() > 100)
+  {
+    s.resize(100);
+  }
+  return s;
+}
+
+std::string hyperFunText(const ModelFile& model)
+{
+  const std::string name = hyperFunName(model.name.empty() ? "model" : model.name);
+  try
+  {
+    return writeHyperFun(model.model, name, model.parameterCount);
+  }
+  catch (const std::invalid_argument&)
+  {
+    // A reserved name (a keyword, a built-in, hf..., v<n>): any prefix the writer accepts will do.
+    return writeHyperFun(model.model, "model_" + name, model.parameterCount);
+  }
+}
+
+[[noreturn]] void saveError(const std::string& path, const std::string& what, int err)
+{
+  throw std::runtime_error("cannot save '" + path + "': " + what +
+    (err ? std::string(": ") + std::strerror(err) : std::string()));
+}
+
+// Writes `text` next to `path` and renames it over `path`: readers see the old file or the new
+// one, never a truncated one, even if this process dies half-way.
+void writeAtomically(const std::string& path, const std::string& text)
+{
+  static std::atomic<unsigned> counter{ 0 };
+  const std::filesystem::path target(path);
+  const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+  const std::string temp = (target.parent_path() /
+    ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+      std::to_string(counter++) + "-" + std::to_string(stamp % 1000000)))
+                             .string();
+  // 0666 and the umask, as for any new file; an existing file keeps its mode.
+  int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0)
+  {
+    saveError(path, "cannot create the temporary file '" + temp + "'", errno);
+  }
+  struct stat existing;
+  if (::stat(path.c_str(), &existing) == 0)
+  {
+    (void)::fchmod(fd, existing.st_mode & 07777);
+  }
+  const char* p = text.data();
+  std::size_t left = text.size();
+  while (left > 0)
+  {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (n <= 0)
+    {
+      const int err = errno;
+      ::close(fd);
+      ::unlink(temp.c_str());
+      saveError(path, "cannot write the temporary file", err);
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  // The data must be on disk before the rename makes it the file, or a crash could leave an
+  // empty file under the final name.
+  if (::fsync(fd) != 0 || ::close(fd) != 0)
+  {
+    const int err = errno;
+    ::unlink(temp.c_str());
+    saveError(path, "cannot write the temporary file", err);
+  }
+  if (::rename(temp.c_str(), path.c_str()) != 0)
+  {
+    const int err = errno;
+    ::unlink(temp.c_str());
+    saveError(path, "cannot rename the temporary file over it", err);
+  }
+}
+} // namespace
+
+bool isModelFile(const std::string& path)
+{
+  return formatOf(path) != Format::Unknown;
+}
+
+ModelFile loadModelFile(const std::string& path, const Limits& limits)
+{
+  switch (formatOf(path))
+  {
+    case Format::HyperFun:
+    {
+      HyperFunModel hf = readHyperFunFile(path, {}, limits);
+      return ModelFile{ std::move(hf.name), hf.parameterCount, std::move(hf.model), std::nullopt };
+    }
+    case Format::Xml:
+    {
+      // readFRepXmlFile's checks (readable, size) first, then the full document.
+      std::string text;
+      {
+        std::error_code ec;
+        const auto size = std::filesystem::file_size(path, ec);
+        if (!ec && size > limits.maxFileBytes)
+        {
+          Diagnostic d;
+          d.where.file = path;
+          d.message = "the file has " + std::to_string(size) + " bytes, more than the limit of " +
+            std::to_string(limits.maxFileBytes);
+          throw ParseError({ d });
+        }
+        FILE* f = std::fopen(path.c_str(), "rb");
+        if (!f)
+        {
+          Diagnostic d;
+          d.where.file = path;
+          d.message = "cannot open the file: " + std::string(std::strerror(errno));
+          throw ParseError({ d });
+        }
+        char buf[65536];
+        std::size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0)
+        {
+          text.append(buf, n);
+          if (text.size() > limits.maxFileBytes)
+          {
+            break;
+          }
+        }
+        const bool failed = std::ferror(f);
+        std::fclose(f);
+        if (failed)
+        {
+          Diagnostic d;
+          d.where.file = path;
+          d.message = "cannot read the file";
+          throw ParseError({ d });
+        }
+      }
+      FRepXmlDocument doc = readFRepXmlDocument(text, path, limits);
+      std::string name =
+        doc.name.empty() ? std::filesystem::path(path).stem().string() : std::move(doc.name);
+      return ModelFile{ std::move(name), doc.parameterCount, std::move(*doc.model), doc.bounds };
+    }
+    default:
+      unknownExtension(path);
+  }
+}
+
+void saveModelFile(const ModelFile& model, const std::string& path)
+{
+  std::string text;
+  switch (formatOf(path))
+  {
+    case Format::HyperFun:
+      text = hyperFunText(model);
+      break;
+    case Format::Xml:
+      text = writeFRepXmlDocument(
+        model.model, model.name.empty() ? "model" : model.name, model.parameterCount, model.bounds);
+      break;
+    default:
+      unknownExtension(path);
+  }
+  writeAtomically(path, text);
+}
+
+} // namespace ictk::lang

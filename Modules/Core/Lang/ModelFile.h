@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML).
+
+#include "FRep/Hypervolume.h"
+#include "Lang/Diagnostics.h"
+
+#include <array>
+#include <optional>
+#include <string>
+
+namespace ictk::lang
+{
+
+struct ModelFile
+{
+  std::string name;
+  int parameterCount = 0;
+  frep::Hypervolume model;
+  /// A box that holds the model, when the file says (FRep XML may carry one); otherwise unset.
+  std::optional<std::array<double, 6>> bounds;
+};
+
+/// True for paths ending in .hf or .xml (case-insensitive).
+bool isModelFile(const std::string& path);
+/// Opens a .hf or .xml file; throws ParseError (diagnostics name the file) or
+/// std::invalid_argument for an unknown extension.
+ModelFile loadModelFile(const std::string& path, const Limits& limits = {});
+/// Saves as .hf or .xml by extension, through a temporary file renamed on success.
+void saveModelFile(const ModelFile& model, const std::string& path);
+
+} // namespace ictk::lang

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// libFuzzer target: any input must either compile or raise ParseError. Anything else escaping
+// (another exception, a crash, a sanitizer report, a timeout or running out of memory) is a bug.
+#include "Lang/HyperFun.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+  ictk::lang::Limits limits;
+  // Small budgets keep every run fast; the limits themselves are what is being exercised.
+  limits.maxLoopIterations = 100000;
+  limits.maxExpressionNodes = 200000;
+  limits.maxSyntaxNodes = 100000;
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try
+  {
+    const auto model = ictk::lang::readHyperFun(text, "fuzz.hf", {}, limits);
+    (void)model.model.compile();
+  }
+  catch (const ictk::lang::ParseError&)
+  {
+  }
+  return 0;
+}
