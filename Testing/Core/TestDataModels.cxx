@@ -240,6 +240,29 @@ TEST(DataModels, LibraryModelsMatchTheCppKernel)
     const Shape soft = frep::softObject(cs, { 1.2, 1.2, 1.2 }, 0.2);
     expectSameField(load("blobs.hf"), unite(unite(blobby, meta), soft));
   }
+  {
+    // space_map_warp: the ball's coordinates go through hfSpaceMapCubic, then hfSpaceMapExp (in
+    // place), so the C++ map applied first is the outer one; the rod only through hfSpaceMapExp.
+    const std::vector<frep::Vec3> src{ { 0, 0, 0.8 }, { 0.8, 0, 0 } };
+    const std::vector<frep::Vec3> dst{ { 0, 0, 1.2 }, { 1.1, 0.2, 0 } };
+    const std::vector<frep::Vec3> b{ { 0.8, 0.8, 1.3 }, { 1.2, 1.2, 1.2 } };
+    const std::vector<frep::Vec3> es{ { 0, 0, -0.8 } }, ed{ { 0.4, 0, -0.8 } },
+      eb{ { 0.5, 0.5, 0.3 } };
+    const Shape ball = frep::spaceMapCubic(
+      frep::spaceMapExp(frep::sphere({ 0, 0, 0 }, 0.9), es, ed, eb), src, dst, b);
+    const Shape rod =
+      frep::spaceMapExp(frep::ellipsoid({ 0, 0, -1.6 }, 0.25, 0.25, 0.8), es, ed, eb);
+    const auto m = load("space_map_warp.hf");
+    expectSameField(m, unite(ball, rod));
+    // The target (0, 0, 1.2) of the first control point maps exactly onto its source (0, 0, 0.8)
+    // (w = 1; the second control point and the exp map move it by < 1e-5), where the ball's field
+    // is 0.81 - 0.64 = 0.17: material outside the unwarped ball of radius 0.9.
+    EXPECT_GT(at(m, { 0, 0, 1.2, 0 }), 0.0);
+    EXPECT_GT(at(m, { 1.05, 0.1, 0, 0 }), 0.0); // the side pulled out
+    EXPECT_LT(at(m, { -1.05, 0, 0, 0 }), 0.0);  // the other side is not
+    EXPECT_GT(at(m, { 0.3, 0, -1, 0 }), 0.0);   // the rod pushed towards +x
+    EXPECT_LT(at(m, { -0.3, 0, -1, 0 }), 0.0);
+  }
 }
 
 TEST(DataModels, NoisyEggWithoutNoiseIsTheEllipsoid)

@@ -230,6 +230,55 @@ TEST(HyperFun, SpaceMapsModifyTheirArrayInPlace)
     model("hfShift3D(xt, 1, 2, 3);").function().identical(frep::shift(s, { 1, 2, 3 }).function()));
 }
 
+TEST(HyperFun, ControlPointSpaceMapsAndConvLineR)
+{
+  // hfSpaceMapCubic/Exp(xt, source, target, b) (int_global.c argument order), two control points
+  // (3 items each), applied in place to xt like the other space maps.
+  const auto s = frep::sphere({ 0, 0, 0 }, 1);
+  const std::string pre = "array xt[3], c[3], src[6], dst[6], b[6];\nc = [0, 0, 0];\nxt = x;\n"
+                          "src = [0, 0, 0, 0.5, 0, 0];\ndst = [0.5, 0.2, 0, 0.5, -0.4, 0.3];\n"
+                          "b = [1, 1, 1, 0.8, 2, 1];\n";
+  auto model = [&](const std::string& map)
+  {
+    return geometry("m(x[3], a[1]) {\n" + pre + map + "\nm = hfSphere(xt, c, 1);\n}");
+  };
+  const std::vector<frep::Vec3> src{ { 0, 0, 0 }, { 0.5, 0, 0 } };
+  const std::vector<frep::Vec3> dst{ { 0.5, 0.2, 0 }, { 0.5, -0.4, 0.3 } };
+  const std::vector<frep::Vec3> b{ { 1, 1, 1 }, { 0.8, 2, 1 } };
+  expectSameField(model("hfSpaceMapCubic(xt, src, dst, b);"), frep::spaceMapCubic(s, src, dst, b));
+  expectSameField(model("hfSpaceMapExp(xt, src, dst, b);"), frep::spaceMapExp(s, src, dst, b));
+  // Applied after another map, on the already moved coordinates.
+  expectSameField(model("hfShift3D(xt, 1, 0, 0);\nhfSpaceMapExp(xt, src, dst, b);"),
+    frep::shift(frep::spaceMapExp(s, src, dst, b), { 1, 0, 0 }));
+  // hfConvLineR(x, begin, end, R): two segments.
+  const std::vector<std::array<frep::Vec3, 2>> segs{ { frep::Vec3{ -1, 0, 0 },
+                                                       frep::Vec3{ 0, 0.5, 0 } },
+    { frep::Vec3{ 0, 0.5, 0 }, frep::Vec3{ 1, 0, 0.2 } } };
+  expectLibrary("hfConvLineR(x, bg, en, 0.4)", frep::convolutionSegmentsRadius(segs, 0.4),
+    "array bg[6], en[6];\nbg = [-1, 0, 0, 0, 0.5, 0];\nen = [0, 0.5, 0, 1, 0, 0.2];");
+  // Diagnostics: a source array that is not whole points, a short target, a zero b.
+  auto error = [&](const std::string& map)
+  {
+    try
+    {
+      model(map);
+    }
+    catch (const lang::ParseError& e)
+    {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("array s5[5];\ns5 = [0, 0, 0, 1, 1];\nhfSpaceMapCubic(xt, s5, dst, b);")
+              .find("3 items per control point"),
+    std::string::npos);
+  EXPECT_NE(error("array d3[3];\nd3 = [1, 1, 1];\nhfSpaceMapExp(xt, src, d3, b);")
+              .find("argument 3 of hfSpaceMapExp must have 6 items"),
+    std::string::npos);
+  EXPECT_NE(
+    error("b[2] = 0;\nhfSpaceMapCubic(xt, src, dst, b);").find("influence"), std::string::npos);
+}
+
 TEST(HyperFun, DomainsAndParameters)
 {
   const auto m2 = readHyperFun("disk(x[2], a[2]) { disk = a[1] - x[1]^2 - x[2]^2; }", "d.hf");

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 
 using namespace ictk::frep;
@@ -678,6 +679,97 @@ TEST(Operations, StretchFollowsHfStretch)
       stretch(disk(0, 0, 1), { 0, 0, 0 }, { 1, 1, 3 });
     },
     { "stretch", "z" });
+}
+
+TEST(Operations, SpaceMapCubicFollowsHfSpaceMapCubic)
+{
+  // One control point, source (0, 0, 0) -> target (1, 0, 0), b = (1, 1, 1): d = (1, 0, 0), the
+  // influence half-axes are b_k (1 + |d_k|) = (2, 1, 1). With u = ((x - 1) / 2, y, z), r = |u| and
+  // w = (1 - r)^3 / (1 + r) for r <= 1 (else 0), x' = x - w, y' = y, z' = z. The probe f1 = x
+  // returns x', f2 = y returns y'.
+  //   (1, 0, 0), the target: r = 0, w = 1, x' = 0 (the source).
+  //   (2, 0, 0): r = 1/2, w = (1/8) / (3/2) = 1/12, x' = 23/12.
+  //   (0, 0, 0): r = 1/2, x' = -1/12.   (1, 0.5, 0): r = 1/2, x' = 11/12, y' = 0.5.
+  //   (1, 0, 2): r = 2 > 1, w = 0, x' = 1.   (3, 0, 0): r = 1 exactly, w = 0, x' = 3.
+  const std::vector<Vec3> src{ { 0, 0, 0 } }, dst{ { 1, 0, 0 } }, b{ { 1, 1, 1 } };
+  const Shape mx = spaceMapCubic(probe1, src, dst, b);
+  const Shape my = spaceMapCubic(probe2, src, dst, b);
+  EXPECT_NEAR(eval(mx, 1, 0, 0), 0.0, tol);
+  EXPECT_NEAR(eval(mx, 2, 0, 0), 23.0 / 12, tol);
+  EXPECT_NEAR(eval(mx, 0, 0, 0), -1.0 / 12, tol);
+  EXPECT_NEAR(eval(mx, 1, 0.5, 0), 11.0 / 12, tol);
+  EXPECT_EQ(eval(my, 1, 0.5, 0), 0.5);
+  EXPECT_EQ(eval(mx, 1, 0, 2), 1.0);
+  EXPECT_EQ(eval(mx, 3, 0, 0), 3.0);
+  // A diagonal move: source (0, 0, 0) -> target (1, -2, 0), b = (0.5, 1, 2): d = (1, -2, 0),
+  // half-axes (0.5 * 2, 1 * 3, 2 * 1) = (1, 3, 2). At (1.5, -2, 1): u = (0.5, 0, 0.5),
+  // r = 1/sqrt(2), w = (1 - r)^3 / (1 + r); p' = (1.5 - w, -2 + 2 w, 1), and the field is the test
+  // field there.
+  const double r = 1 / std::sqrt(2.0);
+  const double w = std::pow(1 - r, 3) / (1 + r);
+  const Shape g = spaceMapCubic(testShape(), src, { { 1, -2, 0 } }, { { 0.5, 1, 2 } });
+  EXPECT_NEAR(eval(g, 1.5, -2, 1), testField(1.5 - w, -2 + 2 * w, 1), tol);
+  // The material at the source appears at the target.
+  EXPECT_NEAR(eval(g, 1, -2, 0), testField(0, 0, 0), tol);
+  // No control points: the identity.
+  EXPECT_EQ(eval(spaceMapCubic(testShape(), {}, {}, {}), 0.3, 0.2, 0.1), testField(0.3, 0.2, 0.1));
+}
+
+TEST(Operations, SpaceMapExpFollowsHfSpaceMapExp)
+{
+  // As above with w = exp(-r^2) everywhere: source (0, 0, 0) -> target (1, 0, 0), b = (1, 1, 1),
+  // half-axes (2, 1, 1).
+  //   (1, 0, 0): w = 1, x' = 0.   (2, 0, 0): r^2 = 1/4, x' = 2 - e^(-1/4).
+  //   (1, 0, 2): r^2 = 4, x' = 1 - e^(-4) (no cut-off, unlike the cubic map).
+  const std::vector<Vec3> src{ { 0, 0, 0 } }, dst{ { 1, 0, 0 } }, b{ { 1, 1, 1 } };
+  const Shape mx = spaceMapExp(probe1, src, dst, b);
+  EXPECT_NEAR(eval(mx, 1, 0, 0), 0.0, tol);
+  EXPECT_NEAR(eval(mx, 2, 0, 0), 2 - std::exp(-0.25), tol);
+  EXPECT_NEAR(eval(mx, 1, 0, 2), 1 - std::exp(-4.0), tol);
+  EXPECT_EQ(eval(spaceMapExp(probe3, src, dst, b), 1, 0, 2), 2.0);
+  // Diagonal move as in the cubic test: at (1.5, -2, 1), r^2 = 1/2, w = e^(-1/2).
+  const double w = std::exp(-0.5);
+  const Shape g = spaceMapExp(testShape(), src, { { 1, -2, 0 } }, { { 0.5, 1, 2 } });
+  EXPECT_NEAR(eval(g, 1.5, -2, 1), testField(1.5 - w, -2 + 2 * w, 1), tol);
+  // Two control points act one after the other on the moved point (HyperFun updates its array in
+  // place): (0, 0, 0) -> (1, 0, 0) then (0, 0, 0) -> (0, 1, 0), b = (1, 1, 1) for both. At
+  // (1, 0, 0) the first step gives (0, 0, 0) (w = 1); the second has d = (0, 1, 0), half-axes
+  // (1, 2, 1), u = (0, -1/2, 0), w = e^(-1/4): the point ends at (0, -e^(-1/4), 0). (Evaluating
+  // both steps at the original point would give u = (1, -1/2, 0) instead.)
+  const std::vector<Vec3> src2{ { 0, 0, 0 }, { 0, 0, 0 } }, dst2{ { 1, 0, 0 }, { 0, 1, 0 } },
+    b2{ { 1, 1, 1 }, { 1, 1, 1 } };
+  EXPECT_NEAR(eval(spaceMapExp(probe1, src2, dst2, b2), 1, 0, 0), 0.0, tol);
+  EXPECT_NEAR(eval(spaceMapExp(probe2, src2, dst2, b2), 1, 0, 0), -std::exp(-0.25), tol);
+}
+
+TEST(Operations, SpaceMapValidation)
+{
+  const std::vector<Vec3> one{ { 0, 0, 0 } }, two{ { 0, 0, 0 }, { 1, 1, 1 } };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { spaceMapCubic(unitSphere(), one, two, one); }, { "spaceMapCubic", "target" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] { spaceMapExp(unitSphere(), one, one, two); }, { "spaceMapExp", "influence" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] {
+      spaceMapCubic(unitSphere(), { { nan, 0, 0 } }, one, { { 1, 1, 1 } });
+    },
+    { "spaceMapCubic", "source" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] {
+      spaceMapExp(unitSphere(), one, { { 0, nan, 0 } }, { { 1, 1, 1 } });
+    },
+    { "spaceMapExp", "target" });
+  expectThrowMentioning<std::invalid_argument>(
+    [&] {
+      spaceMapCubic(unitSphere(), one, { { 1, 0, 0 } }, { { 1, 0, 1 } });
+    },
+    { "spaceMapCubic", "influence" });
+  expectThrowMentioning<DomainError>(
+    [&] {
+      spaceMapExp(disk(0, 0, 1), one, { { 1, 0, 0 } }, { { 1, 1, 1 } });
+    },
+    { "spaceMapExp", "z" });
 }
 
 // --- dimension and time ------------------------------------------------------------------------

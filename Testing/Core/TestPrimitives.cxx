@@ -579,6 +579,43 @@ TEST(Convolution, SegmentHandValues)
   EXPECT_NEAR(at(s, 0, 0, -1), at(s, 0, 1, 0), 1e-15);
 }
 
+TEST(Convolution, SegmentsWithRadiusFollowHfConvLineR)
+{
+  // Segment (0,0,0)-(1,0,0), R = 0.5 < 1, so s = 1/R = 2 and l = 1. At the midpoint (axial
+  // coordinate u = 1/2, distance 0): with P^2 = 1 + s^2 * 0 = 1 and both ends at distance 1/2,
+  //   field = int_0^1 du / (1 + 4 (u - 1/2)^2)^2 = 2 [1/2 / (2 * 1 * 2) + atan(1) / (2 * 2)]
+  //         = 1/4 + pi/8.
+  // Threshold: P^2 = 1 + 4 * 0.25 = 2, Q^2 = 2 + 4 * 1 = 6,
+  //   T = 1 / (2 * 2 * 6) + atan(2 / sqrt 2) / (2 * 2 * 2 sqrt 2) = 1/24 + atan(sqrt 2) / (8 sqrt
+  //   2).
+  const double T = 1.0 / 24 + std::atan(std::sqrt(2.0)) / (8 * std::sqrt(2.0));
+  const std::array<Vec3, 2> seg{ Vec3{ 0, 0, 0 }, Vec3{ 1, 0, 0 } };
+  const Shape one = convolutionSegmentsRadius({ seg }, 0.5);
+  EXPECT_NEAR(at(one, 0.5, 0, 0), 0.25 + pi / 8 - T, 1e-15);
+  // At distance R from the start on the normal plane the field is the threshold: f = 0.
+  EXPECT_NEAR(at(one, 0, 0.5, 0), 0.0, 1e-15);
+  EXPECT_NEAR(at(one, 0, 0, -0.5), 0.0, 1e-15);
+  // Two copies of the segment: the sum 2 (1/4 + pi/8) = 1.285 is clamped at 1.
+  const Shape two = convolutionSegmentsRadius({ seg, seg }, 0.5);
+  EXPECT_NEAR(at(two, 0.5, 0, 0), 1.0 - T, 1e-15);
+  // R >= 1 keeps s = 1: the field is convolutionSegments with s = 1 and the threshold above with
+  // s = 1, R = 2: P^2 = 5, Q^2 = 6, T = 1/60 + atan(1/sqrt 5) / (2 * 5 sqrt 5).
+  const double T2 = 1.0 / 60 + std::atan(1 / std::sqrt(5.0)) / (10 * std::sqrt(5.0));
+  EXPECT_NEAR(at(convolutionSegmentsRadius({ seg }, 2), 0.3, 0.4, 0.1),
+    at(convolutionSegments({ seg }, { 1 }, T2), 0.3, 0.4, 0.1), 1e-15);
+  expectInvalid([] { convolutionSegmentsRadius({}, 0.5); },
+    { "convolutionSegmentsRadius", "segments", "empty" });
+  expectInvalid(
+    [&] { convolutionSegmentsRadius({ seg }, 0); }, { "convolutionSegmentsRadius", "radius R" });
+  expectInvalid([&] { convolutionSegmentsRadius({ seg }, notANumber); },
+    { "convolutionSegmentsRadius", "radius R" });
+  expectInvalid(
+    [] {
+      convolutionSegmentsRadius({ { Vec3{ 1, 1, 1 }, Vec3{ 1, 1, 1 } } }, 1);
+    },
+    { "convolutionSegmentsRadius", "segments[0]", "zero length" });
+}
+
 TEST(Convolution, SegmentMatchesQuadrature)
 {
   // thesis_ch5_6.md T-5.4 item 1: relative error < 1e-8 at 1000 random points.

@@ -636,6 +636,106 @@ Shape stretch(const Shape& a, const Vec3& center, const Vec3& factors)
   return mapped(a, map, "stretch");
 }
 
+namespace
+{
+enum class Falloff
+{
+  Cubic,
+  Exp
+};
+
+// hfSpaceMapCubic.c / hfSpaceMapExp.c: HyperFun walks the control points in order and moves its
+// coordinate array in place, so step i sees the point produced by step i - 1. Here the point is a
+// triple of Exprs and each step rewrites it, which composes the steps in the same order.
+Shape controlPointMap(const char* op, Falloff falloff, const Shape& a,
+  const std::vector<Vec3>& source, const std::vector<Vec3>& target,
+  const std::vector<Vec3>& influence)
+{
+  if (target.size() != source.size())
+  {
+    invalid(op,
+      "parameters source and target must have the same length, got " +
+        std::to_string(source.size()) + " and " + std::to_string(target.size()));
+  }
+  if (influence.size() != source.size())
+  {
+    invalid(op,
+      "parameters source and influence must have the same length, got " +
+        std::to_string(source.size()) + " and " + std::to_string(influence.size()));
+  }
+  for (std::size_t i = 0; i < source.size(); ++i)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      requireFinite(op, "source", source[i][k]);
+      requireFinite(op, "target", target[i][k]);
+      requireNonZero(op, "influence", influence[i][k]);
+    }
+  }
+  requireAxes(op, a, xyzBits);
+  std::array<Expr, 3> p = { Expr::x(), Expr::y(), Expr::z() };
+  for (std::size_t i = 0; i < source.size(); ++i)
+  {
+    Vec3 d;
+    for (int k = 0; k < 3; ++k)
+    {
+      d[k] = target[i][k] - source[i][k];
+    }
+    if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
+    {
+      continue; // w is finite, so p - w * 0 = p: the step is the identity.
+    }
+    Expr r2;
+    for (int k = 0; k < 3; ++k)
+    {
+      // The ellipsoid of influence grows with the displacement along each axis.
+      const double radius = influence[i][k] * (1.0 + std::fabs(d[k]));
+      const Expr u = (p[k] - target[i][k]) / radius;
+      r2 = k == 0 ? square(u) : r2 + square(u);
+    }
+    Expr w;
+    if (falloff == Falloff::Cubic)
+    {
+      // (1 - r)^3 / (1 + r) for r <= 1; clamping r at 1 makes it exactly 0 beyond, continuously.
+      const Expr r = min(sqrt(r2), Expr(1.0));
+      const Expr oneMinus = 1.0 - r;
+      w = square(oneMinus) * oneMinus / (1.0 + r);
+    }
+    else
+    {
+      w = exp(-r2);
+    }
+    std::array<Expr, 3> next = p;
+    for (int k = 0; k < 3; ++k)
+    {
+      if (d[k] != 0.0)
+      {
+        next[k] = p[k] - w * d[k];
+      }
+    }
+    p = next;
+  }
+  auto map = identityMap();
+  for (int k = 0; k < 3; ++k)
+  {
+    map[k] = p[k];
+  }
+  return mapped(a, map, op);
+}
+} // namespace
+
+Shape spaceMapCubic(const Shape& a, const std::vector<Vec3>& source,
+  const std::vector<Vec3>& target, const std::vector<Vec3>& influence)
+{
+  return controlPointMap("spaceMapCubic", Falloff::Cubic, a, source, target, influence);
+}
+
+Shape spaceMapExp(const Shape& a, const std::vector<Vec3>& source, const std::vector<Vec3>& target,
+  const std::vector<Vec3>& influence)
+{
+  return controlPointMap("spaceMapExp", Falloff::Exp, a, source, target, influence);
+}
+
 // --- dimension and time --------------------------------------------------------------------------
 
 Shape cartesianProduct(const Shape& a, const Shape& b)

@@ -85,6 +85,20 @@ Shape taper(const Shape& a, Axis axis, double z1, double z2, double s1, double s
 Shape bend(const Shape& a, Axis axis, double curvature);
 /// Stretch about a centre [hfStretch3D: x' = x0 + (x - x0) / sx]; factors must be non-zero.
 Shape stretch(const Shape& a, const Vec3& center, const Vec3& factors);
+/// Local warps by control points [hfSpaceMapCubic, hfSpaceMapExp]: the material at source[i] is
+/// carried to target[i], space near target[i] following. The query point p is inverse-mapped one
+/// control point after the other (i = 0, 1, ...), each step using the point left by the previous
+/// one, as HyperFun updates its coordinate array in place:
+///   d = target[i] - source[i],  u_k = (p_k - target[i]_k) / (b[i]_k (1 + |d_k|))  (k = x, y, z),
+///   r^2 = u_x^2 + u_y^2 + u_z^2,  p <- p - w(r) d,
+/// with w = (1 - r)^3 / (1 + r) for r <= 1 and 0 beyond (cubic; zero outside the ellipsoid of
+/// half-axes b_k (1 + |d_k|) about the target), or w = exp(-r^2) (exp; everywhere). `influence`
+/// holds b[i] per control point. The three lists must have one length (empty: the identity);
+/// every value must be finite and each b component non-zero. Needs x, y, z.
+Shape spaceMapCubic(const Shape& a, const std::vector<Vec3>& source,
+  const std::vector<Vec3>& target, const std::vector<Vec3>& influence);
+Shape spaceMapExp(const Shape& a, const std::vector<Vec3>& source, const std::vector<Vec3>& target,
+  const std::vector<Vec3>& influence);
 
 // --- dimension and time --------------------------------------------------------------------------
 /// Cartesian product of shapes on disjoint coordinate sets (L1139-L1141): the R-intersection of

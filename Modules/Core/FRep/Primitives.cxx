@@ -774,6 +774,31 @@ Shape convolutionSegments(
   return thresholded(std::move(terms), threshold, "convolutionSegments");
 }
 
+// hfconvliner.c: the width comes from the radius, the threshold from the last segment, and the
+// running sum stops at 1. The per-segment field is the one of hfConvLine.
+Shape convolutionSegmentsRadius(const std::vector<std::array<Vec3, 2>>& segments, double radius)
+{
+  const char* name = "convolutionSegmentsRadius";
+  requireNonEmpty(name, "segments", segments.size());
+  requirePositive(name, "radius R", radius);
+  const double s = radius < 1.0 ? 1.0 / radius : 1.0;
+  Expr sum;
+  for (std::size_t i = 0; i < segments.size(); ++i)
+  {
+    const Expr field =
+      segmentField(name, indexed("segments", i), segments[i][0], segments[i][1], s);
+    sum = min(i == 0 ? field : sum + field, Expr(1.0));
+  }
+  // The last segment's field at distance R from its start (axial coordinate 0).
+  const Vec3 axis = sub(segments.back()[1], segments.back()[0]);
+  const double l = std::sqrt(dot(axis, axis));
+  const double P2 = 1.0 + s * s * radius * radius;
+  const double P = std::sqrt(P2);
+  const double Q2 = 1.0 + s * s * (radius * radius + l * l);
+  const double T = l / (2.0 * P2 * Q2) + std::atan(s * l / P) / (2.0 * s * P2 * P);
+  return Shape(sum - T, Domain::XYZ, name);
+}
+
 Shape convolutionArcs(const std::vector<Vec3>& centers, const std::vector<double>& radii,
   const std::vector<double>& thetas, const std::vector<Vec3>& axes,
   const std::vector<double>& angles, const std::vector<double>& s, double threshold)

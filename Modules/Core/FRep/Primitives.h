@@ -93,6 +93,14 @@ Shape convolutionPoints(
 /// Line segments [hfConvLine].
 Shape convolutionSegments(
   const std::vector<std::array<Vec3, 2>>& segments, const std::vector<double>& s, double threshold);
+/// Line segments given a radius instead of s and T [hfConvLineR]: one kernel width for all,
+/// s = 1/R for R < 1 and s = 1 otherwise; the segment fields are summed in order with the running
+/// sum clamped at 1 (min(sum + field_i, 1)); the threshold is the field of the last segment alone
+/// at distance R from its start, on the plane normal to it there:
+///   T = l / (2 P^2 Q^2) + atan(s l / P) / (2 s P^3),  P^2 = 1 + s^2 R^2,  Q^2 = P^2 + s^2 l^2,
+/// l the last segment's length. R > 0; segments must have non-zero length (hfConvLineR divides by
+/// the length).
+Shape convolutionSegmentsRadius(const std::vector<std::array<Vec3, 2>>& segments, double radius);
 /// Circular arcs [hfConvArc], in HyperFun's parametrisation: arc i has its center, radius and
 /// opening angle theta (degrees, 0 < theta <= 360); before rotation it lies in the plane z = 0 of
 /// its center, starting on the +x direction and turning counter-clockwise; it is then rotated by

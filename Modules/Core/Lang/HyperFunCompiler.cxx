@@ -1319,6 +1319,23 @@ const std::unordered_map<std::string, Compiler::Handler>& Compiler::library()
     }
     return place(kernel(n, [&] { return frep::convolutionSegments(segs, s, T).function(); }), m, n);
   };
+  L["hfconvliner"] = [=](Frame& f, const ExprNode& n)
+  {
+    // hfConvLineR(x, begin, end, R): the end array sets the number of segments.
+    args(n, 4);
+    const auto m = coordinates(f, n, 0);
+    const std::size_t k = constants(f, n, 2).size() / 3;
+    const auto b = points(f, n, 1, k);
+    const auto e = points(f, n, 2, k);
+    const double R = number(f, n, 3);
+    std::vector<std::array<Vec3, 2>> segs(k);
+    for (std::size_t i = 0; i < k; ++i)
+    {
+      segs[i] = { b[i], e[i] };
+    }
+    return place(
+      kernel(n, [&] { return frep::convolutionSegmentsRadius(segs, R).function(); }), m, n);
+  };
   L["hfconvarc"] = [=](Frame& f, const ExprNode& n)
   {
     // hfConvArc(x, center, radius, theta, axis, angle, S, T); its field is integrated over the
@@ -1450,6 +1467,33 @@ const std::unordered_map<std::string, Compiler::Handler>& Compiler::library()
     const Vec3 v = { number(f, n, 2), number(f, n, 3), number(f, n, 4) };
     return spaceMap(f, n, [&](const Shape& s) { return frep::stretch(s, c, v); });
   };
+  // hfSpaceMapCubic/Exp(xt, source, target, b) (int_global.c): the number of control points is
+  // set by the source array (3 items each); target and b are read for as many.
+  auto controlPoints = [=](bool cubic)
+  {
+    return [=](Frame& f, const ExprNode& n)
+    {
+      args(n, 4);
+      const auto all = constants(f, n, 1);
+      if (all.size() % 3 != 0)
+      {
+        const ExprNode& an = node(n.kids[1]);
+        fail(an.line, an.column,
+          "argument 2 of " + n.spelling + " must have 3 items per control point, it has " +
+            std::to_string(all.size()));
+      }
+      const std::size_t k = all.size() / 3;
+      const auto src = points(f, n, 1, k);
+      const auto dst = points(f, n, 2, k);
+      const auto b = points(f, n, 3, k);
+      return spaceMap(f, n,
+        [&](const Shape& s) {
+          return cubic ? frep::spaceMapCubic(s, src, dst, b) : frep::spaceMapExp(s, src, dst, b);
+        });
+    };
+  };
+  L["hfspacemapcubic"] = controlPoints(true);
+  L["hfspacemapexp"] = controlPoints(false);
   // Attributes: hfA_SetColor(f, s, r, g, b) and hfA_SetAttributes(f, s, s1) write into s where
   // f >= 0 (hfA_SetColor.c, hfA_SetAttributes.c).
   L["hfa_setcolor"] = [=](Frame& f, const ExprNode& n)
