@@ -462,6 +462,24 @@ private:
     error(child, "unexpected text in " + tag(parent));
   }
 
+  /// The element children of `parent`, in order; text among them is reported.
+  std::vector<pugi::xml_node> elementChildren(const pugi::xml_node& parent)
+  {
+    std::vector<pugi::xml_node> elements;
+    for (pugi::xml_node c : parent.children())
+    {
+      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
+      {
+        rejectText(c, parent);
+      }
+      else if (c.type() == pugi::node_element)
+      {
+        elements.push_back(c);
+      }
+    }
+    return elements;
+  }
+
   // ----- document
 
   void readDocument(FRepXmlDocument& result)
@@ -530,17 +548,8 @@ private:
     }
 
     pugi::xml_node geometry;
-    for (pugi::xml_node n : root.children())
+    for (pugi::xml_node n : elementChildren(root))
     {
-      if (n.type() == pugi::node_pcdata || n.type() == pugi::node_cdata)
-      {
-        rejectText(n, root);
-        continue;
-      }
-      if (n.type() != pugi::node_element)
-      {
-        continue;
-      }
       const std::string name = n.name();
       if (name == "bounds")
       {
@@ -663,17 +672,8 @@ private:
     }
     std::optional<Expr> f;
     bool first = true;
-    for (pugi::xml_node c : n.children())
+    for (pugi::xml_node c : elementChildren(n))
     {
-      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
-      {
-        rejectText(c, n);
-        continue;
-      }
-      if (c.type() != pugi::node_element)
-      {
-        continue;
-      }
       if (std::strcmp(c.name(), "defs") == 0)
       {
         if (!first)
@@ -711,17 +711,8 @@ private:
   void readDefs(const pugi::xml_node& n)
   {
     checkAttributes(n, {});
-    for (pugi::xml_node c : n.children())
+    for (pugi::xml_node c : elementChildren(n))
     {
-      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
-      {
-        rejectText(c, n);
-        continue;
-      }
-      if (c.type() != pugi::node_element)
-      {
-        continue;
-      }
       if (!c.attribute("id"))
       {
         error(c, "a definition in <defs> needs an 'id'");
@@ -735,17 +726,8 @@ private:
   {
     checkAttributes(n, {});
     std::optional<Expr> e;
-    for (pugi::xml_node c : n.children())
+    for (pugi::xml_node c : elementChildren(n))
     {
-      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
-      {
-        rejectText(c, n);
-        continue;
-      }
-      if (c.type() != pugi::node_element)
-      {
-        continue;
-      }
       if (e)
       {
         error(c, tag(n) + " holds one expression; found another, " + tag(c));
@@ -794,17 +776,8 @@ private:
       }
     }
     bool havePartition = false, haveInside = false, haveOutside = false;
-    for (pugi::xml_node c : n.children())
+    for (pugi::xml_node c : elementChildren(n))
     {
-      if (c.type() == pugi::node_pcdata || c.type() == pugi::node_cdata)
-      {
-        rejectText(c, n);
-        continue;
-      }
-      if (c.type() != pugi::node_element)
-      {
-        continue;
-      }
       const std::string name = c.name();
       if (name == "partition")
       {

@@ -21,6 +21,7 @@
 #include "FRep/Operations.h"
 #include "FRep/Primitives.h"
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -1148,77 +1149,49 @@ const std::unordered_map<std::string, Compiler::Handler>& Compiler::library()
   {
     arity(n, k);
   };
-  L["hfsphere"] = [=](Frame& f, const ExprNode& n)
+  // Primitives called as hfName(x, centre, scalars...): `build(centre, scalars)` makes the shape.
+  using Scalars = std::array<double, 5>;
+  auto centred = [=](
+                   std::size_t scalarCount, std::function<Shape(const Vec3&, const Scalars&)> build)
   {
-    args(n, 3);
-    const auto m = coordinates(f, n, 0);
-    const Vec3 c = vec3(f, n, 1);
-    const double r = number(f, n, 2);
-    return place(kernel(n, [&] { return frep::sphere(c, r).function(); }), m, n);
+    return [=](Frame& f, const ExprNode& n)
+    {
+      args(n, 2 + scalarCount);
+      const auto m = coordinates(f, n, 0);
+      const Vec3 c = vec3(f, n, 1);
+      Scalars v{};
+      for (std::size_t i = 0; i < scalarCount; ++i)
+      {
+        v[i] = number(f, n, 2 + i);
+      }
+      return place(kernel(n, [&] { return build(c, v).function(); }), m, n);
+    };
   };
-  L["hfellipsoid"] = [=](Frame& f, const ExprNode& n)
-  {
-    args(n, 5);
-    const auto m = coordinates(f, n, 0);
-    const Vec3 c = vec3(f, n, 1);
-    const double a = number(f, n, 2), b = number(f, n, 3), cc = number(f, n, 4);
-    return place(kernel(n, [&] { return frep::ellipsoid(c, a, b, cc).function(); }), m, n);
-  };
-  L["hfblock"] = [=](Frame& f, const ExprNode& n)
-  {
-    args(n, 5);
-    const auto m = coordinates(f, n, 0);
-    const Vec3 v = vec3(f, n, 1);
-    const double dx = number(f, n, 2), dy = number(f, n, 3), dz = number(f, n, 4);
-    // hfBlock.c uses the global ALPHA, 0 by default.
-    return place(
-      kernel(n, [&] { return frep::blockRFunction(v, dx, dy, dz, 0.0).function(); }), m, n);
-  };
+  L["hfsphere"] = centred(1, [](const Vec3& c, const Scalars& v) { return frep::sphere(c, v[0]); });
+  L["hfellipsoid"] = centred(
+    3, [](const Vec3& c, const Scalars& v) { return frep::ellipsoid(c, v[0], v[1], v[2]); });
+  // hfBlock.c uses the global ALPHA, 0 by default: the R-function block, not the min form.
+  L["hfblock"] = centred(3,
+    [](const Vec3& vertex, const Scalars& v)
+    { return frep::blockRFunction(vertex, v[0], v[1], v[2], 0.0); });
+  L["hfsuperell"] = centred(5,
+    [](const Vec3& c, const Scalars& v)
+    { return frep::superellipsoid(c, v[0], v[1], v[2], v[3], v[4]); });
   const std::pair<const char*, Axis> axes[] = { { "x", Axis::X }, { "y", Axis::Y },
     { "z", Axis::Z } };
   for (const auto& [suffix, axis] : axes)
   {
     const Axis ax = axis;
-    L[std::string("hfcylinder") + suffix] = [=](Frame& f, const ExprNode& n)
-    {
-      args(n, 3);
-      const auto m = coordinates(f, n, 0);
-      const Vec3 c = vec3(f, n, 1);
-      const double r = number(f, n, 2);
-      return place(kernel(n, [&] { return frep::cylinder(ax, c, r).function(); }), m, n);
-    };
-    L[std::string("hfellcyl") + suffix] = [=](Frame& f, const ExprNode& n)
-    {
-      args(n, 4);
-      const auto m = coordinates(f, n, 0);
-      const Vec3 c = vec3(f, n, 1);
-      const double a = number(f, n, 2), b = number(f, n, 3);
-      return place(kernel(n, [&] { return frep::ellipticCylinder(ax, c, a, b).function(); }), m, n);
-    };
-    L[std::string("hfcone") + suffix] = [=](Frame& f, const ExprNode& n)
-    {
-      args(n, 3);
-      const auto m = coordinates(f, n, 0);
-      const Vec3 c = vec3(f, n, 1);
-      const double r = number(f, n, 2);
-      return place(kernel(n, [&] { return frep::cone(ax, c, r).function(); }), m, n);
-    };
-    L[std::string("hfellcone") + suffix] = [=](Frame& f, const ExprNode& n)
-    {
-      args(n, 4);
-      const auto m = coordinates(f, n, 0);
-      const Vec3 c = vec3(f, n, 1);
-      const double a = number(f, n, 2), b = number(f, n, 3);
-      return place(kernel(n, [&] { return frep::ellipticCone(ax, c, a, b).function(); }), m, n);
-    };
-    L[std::string("hftorus") + suffix] = [=](Frame& f, const ExprNode& n)
-    {
-      args(n, 4);
-      const auto m = coordinates(f, n, 0);
-      const Vec3 c = vec3(f, n, 1);
-      const double R = number(f, n, 2), r = number(f, n, 3);
-      return place(kernel(n, [&] { return frep::torus(ax, c, R, r).function(); }), m, n);
-    };
+    L[std::string("hfcylinder") + suffix] =
+      centred(1, [=](const Vec3& c, const Scalars& v) { return frep::cylinder(ax, c, v[0]); });
+    L[std::string("hfellcyl") + suffix] = centred(2,
+      [=](const Vec3& c, const Scalars& v) { return frep::ellipticCylinder(ax, c, v[0], v[1]); });
+    L[std::string("hfcone") + suffix] =
+      centred(1, [=](const Vec3& c, const Scalars& v) { return frep::cone(ax, c, v[0]); });
+    L[std::string("hfellcone") + suffix] = centred(
+      2, [=](const Vec3& c, const Scalars& v) { return frep::ellipticCone(ax, c, v[0], v[1]); });
+    L[std::string("hftorus") + suffix] =
+      centred(2, [=](const Vec3& c, const Scalars& v) { return frep::torus(ax, c, v[0], v[1]); });
     L[std::string("hfrotate3d") + suffix] = [=](Frame& f, const ExprNode& n)
     {
       args(n, 2);
@@ -1240,16 +1213,6 @@ const std::unordered_map<std::string, Compiler::Handler>& Compiler::library()
       return spaceMap(f, n, [&](const Shape& s) { return frep::taper(s, ax, z1, z2, s1, s2); });
     };
   }
-  L["hfsuperell"] = [=](Frame& f, const ExprNode& n)
-  {
-    args(n, 7);
-    const auto m = coordinates(f, n, 0);
-    const Vec3 c = vec3(f, n, 1);
-    const double a = number(f, n, 2), b = number(f, n, 3), cc = number(f, n, 4),
-                 s1 = number(f, n, 5), s2 = number(f, n, 6);
-    return place(
-      kernel(n, [&] { return frep::superellipsoid(c, a, b, cc, s1, s2).function(); }), m, n);
-  };
   // hfBlobby(x, x0, y0, z0, a, b, T), hfMetaBall(x, x0, y0, z0, b, d, T), hfSoft(x, x0, y0, z0,
   // d, T): centres given as three coordinate arrays.
   auto centres = [this](Frame& f, const ExprNode& n, std::size_t& count)
