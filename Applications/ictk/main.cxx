@@ -464,11 +464,11 @@ constexpr double FileSearchHalfWidth = 10.0;
 
 /// Opens a model file, turning its diagnostics into the user error (they name file, line and
 /// column already).
-lang::ModelFile OpenModelFile(const std::string& path)
+lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>& params = {})
 {
   try
   {
-    return lang::loadModelFile(path);
+    return lang::loadModelFile(path, {}, params);
   }
   catch (const lang::ParseError& e)
   {
@@ -486,15 +486,16 @@ lang::ModelFile OpenModelFile(const std::string& path)
   }
 }
 
-/// A registered model's name or a model file (.hf, .xml).
-ResolvedModel ResolveModel(const std::string& nameOrPath)
+/// A registered model's name or a model file (.hf, .xml). A HyperFun file is specialised to the
+/// parameter values given (--params), so they may stand where its library needs numbers.
+ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<double>& params)
 {
   if (!lang::isModelFile(nameOrPath))
   {
     const frep::ModelInfo& info = FindModel(nameOrPath);
     return { info.name, info.build(), info.boundsLo, info.boundsHi };
   }
-  lang::ModelFile file = OpenModelFile(nameOrPath);
+  lang::ModelFile file = OpenModelFile(nameOrPath, params);
   ResolvedModel model{ file.name, std::move(file.model), {}, {} };
   if (file.bounds)
   {
@@ -506,12 +507,14 @@ ResolvedModel ResolveModel(const std::string& nameOrPath)
   // No bounds in the file: find them by interval arithmetic, the domain's missing axes flat.
   const frep::Box search{ { -FileSearchHalfWidth, -FileSearchHalfWidth, -FileSearchHalfWidth },
     { FileSearchHalfWidth, FileSearchHalfWidth, FileSearchHalfWidth } };
-  const std::vector<double> params(static_cast<std::size_t>(file.parameterCount), 0.0);
+  std::vector<double> boundParams = params;
+  boundParams.resize(
+    std::max(boundParams.size(), static_cast<std::size_t>(file.parameterCount)), 0.0);
   std::optional<frep::Box> box;
   try
   {
     box = frep::boundingBox(
-      frep::Tape::compile(model.Model.geometry().function()), search, 6, 0.0, params);
+      frep::Tape::compile(model.Model.geometry().function()), search, 6, 0.0, boundParams);
   }
   catch (const std::invalid_argument&)
   {
@@ -540,11 +543,11 @@ struct EvalOptions
 
 int RunEval(const EvalOptions& o)
 {
-  const ResolvedModel model = ResolveModel(o.Model);
   const std::vector<double> at =
     ParseNumbers(o.At, "--at", { "x", "y", "z", "t" }, 3, 4, "x,y,z or x,y,z,t");
   const std::array<double, 4> p{ at[0], at[1], at[2], at.size() > 3 ? at[3] : 0.0 };
   const std::vector<double> params = ParseParameters(o.Params);
+  const ResolvedModel model = ResolveModel(o.Model, params);
 
   const frep::Hypervolume& hv = model.Model;
   std::vector<double> attributes(hv.attributeComponentCount());
@@ -699,7 +702,8 @@ struct GridPlan
 
 GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
 {
-  GridPlan plan{ ResolveModel(o.Model), ParseParameters(o.Params), {}, {} };
+  const std::vector<double> params = ParseParameters(o.Params);
+  GridPlan plan{ ResolveModel(o.Model, params), params, {}, {} };
   if (!std::isfinite(o.Time))
   {
     throw UserError("--time must be a finite number");

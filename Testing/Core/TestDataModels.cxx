@@ -65,7 +65,9 @@ TEST(DataModels, EveryModelReadsAndSamples)
       continue;
     }
     SCOPED_TRACE(entry.path().string());
-    const lang::HyperFunModel m = lang::readHyperFunFile(entry.path().string());
+    // Specialised to parameter values, as ictk does with --params (parametric_ring needs them).
+    const lang::HyperFunModel m =
+      lang::readHyperFunFile(entry.path().string(), {}, {}, { 0.8, 0.3 });
     const frep::TapePtr tape = frep::Tape::compile(m.model.geometry().function());
     const frep::Grid grid = frep::gridOverBox({ -2, -2, -2 }, { 2, 2, 2 }, { 9, 9, 9 }, 0.5);
     std::vector<float> values(static_cast<std::size_t>(grid.pointCount()));
@@ -303,7 +305,8 @@ TEST(DataModels, HyperFunXmlHyperFunRoundTripIsValueIdentical)
       continue;
     }
     SCOPED_TRACE(entry.path().string());
-    const lang::HyperFunModel original = lang::readHyperFunFile(entry.path().string());
+    const lang::HyperFunModel original =
+      lang::readHyperFunFile(entry.path().string(), {}, {}, { 0.7, 0.7 });
     const std::string xml = lang::writeFRepXml(original.model, original.name);
     const frep::Hypervolume fromXml = lang::readFRepXml(xml, "round-trip.xml");
     const std::string hf = lang::writeHyperFun(fromXml, original.name, original.parameterCount);
@@ -330,4 +333,15 @@ TEST(DataModels, HyperFunXmlHyperFunRoundTripIsValueIdentical)
       EXPECT_NE(back.model.findAttribute("colour"), nullptr);
     }
   }
+}
+
+TEST(DataModels, ParametricRingIsSpecialisedToItsParameters)
+{
+  // hfTorusZ with R = a[1] = 0.8, r = a[2] = 0.3: r^2 - |p|^2 - R^2 + 2 R sqrt(x^2 + y^2); at
+  // (0.8, 0, 0): 0.09 - 0.64 - 0.64 + 1.28 = 0.09; at the centre: 0.09 - 0.64 = -0.55.
+  const auto m =
+    lang::readHyperFunFile(DataDir + "/Models/parametric_ring.hf", {}, {}, { 0.8, 0.3 });
+  EXPECT_NEAR(at(m, { 0.8, 0, 0, 0 }), 0.09, 1e-15);
+  EXPECT_NEAR(at(m, { 0, 0, 0, 0 }), -0.55, 1e-15);
+  EXPECT_THROW(load("parametric_ring.hf"), lang::ParseError); // no values: the library needs them
 }

@@ -507,3 +507,24 @@ TEST(HyperFun, NeverCrashesOnGarbage)
     }
   }
 }
+
+TEST(HyperFun, ParametersSpecialiseLibraryArguments)
+{
+  // a[1] as a radius and a[2] in a centre: refused as parameter slots (the library needs numbers),
+  // accepted once the model is specialised to values, giving the ball of radius 0.8 at (0.5, 0, 0).
+  const std::string text = "m(x[3], a[2]) {\n array c[3];\n c = [a[2], 0, 0];\n"
+                           " m = hfSphere(x, c, a[1]);\n}\n";
+  try
+  {
+    readHyperFun(text, "p.hf");
+    FAIL() << "a parameter as a library argument was accepted without values";
+  }
+  catch (const lang::ParseError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("give their values"), std::string::npos) << e.what();
+  }
+  const auto m = readHyperFun(text, "p.hf", {}, {}, { 0.8, 0.5 });
+  EXPECT_EQ(m.parameterCount, 2);
+  expectSameField(m.model.geometry(), frep::sphere({ 0.5, 0, 0 }, 0.8));
+  EXPECT_THROW(readHyperFun(text, "p.hf", {}, {}, { 0.8 }), lang::ParseError);
+}

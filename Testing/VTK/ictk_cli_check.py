@@ -270,6 +270,13 @@ def check_model_files(ictk, work):
         sys.exit(f"FAIL: diagnostics:\n{p.stderr}")
     if not any(re.match(re.escape(bad) + r":4:10: error: ", l) for l in lines):
         sys.exit(f"FAIL: the second error is not reported:\n{p.stderr}")
+    # A parameter where the library needs a number: specialised to --params.
+    ring = os.path.join(data, "parametric_ring.hf")
+    near(float(run(ictk, ["eval", ring, "--at", "0.8,0,0", "--params", "0.8,0.3"]).stdout), 0.09, 1e-15,
+         "parametric_ring at (0.8, 0, 0)")
+    p = run(ictk, ["eval", ring, "--at", "0.8,0,0"], check=False)
+    if p.returncode != 2 or "give their values" not in p.stderr:
+        sys.exit(f"FAIL: parametric_ring without --params:\n{p.stderr}")
     missing = os.path.join(work, "no-such.hf")
     p = run(ictk, ["eval", missing, "--at", "0,0,0"], check=False)
     if p.returncode != 2 or not p.stderr.startswith(missing + ": error: cannot open"):

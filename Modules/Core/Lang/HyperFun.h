@@ -6,6 +6,7 @@
 #include "Lang/Diagnostics.h"
 
 #include <string>
+#include <vector>
 
 namespace ictk::lang
 {
@@ -20,12 +21,17 @@ struct HyperFunModel
 };
 
 /// Compiles HyperFun source text; `fileName` is used in diagnostics. The model is the function
-/// named `function`, or the last function of the file when empty. Throws ParseError.
+/// named `function`, or the last function of the file when empty. With `parameterValues` the model
+/// is specialised to them: its parameter array holds those constants, so parameters may also stand
+/// where HyperFun's library needs numbers (a radius, a centre); without, the parameters are slots
+/// (Expr::parameter) set at evaluation time, and such library arguments are an error that says so.
+/// Throws ParseError.
 HyperFunModel readHyperFun(const std::string& text, const std::string& fileName,
-  const std::string& function = {}, const Limits& limits = {});
+  const std::string& function = {}, const Limits& limits = {},
+  const std::vector<double>& parameterValues = {});
 /// Reads and compiles a file. Throws ParseError (also for an unreadable or too large file).
-HyperFunModel readHyperFunFile(
-  const std::string& path, const std::string& function = {}, const Limits& limits = {});
+HyperFunModel readHyperFunFile(const std::string& path, const std::string& function = {},
+  const Limits& limits = {}, const std::vector<double>& parameterValues = {});
 
 /// Prints a hypervolume as a HyperFun model that reads back to the same field (bit-identical
 /// values on the point evaluator) and attributes. `parameterCount` sizes the `a` array.

@@ -102,10 +102,12 @@ int hfRound(double d)
 class Compiler
 {
 public:
-  Compiler(const Program& program, DiagnosticSink& sink, const Limits& limits)
+  Compiler(const Program& program, DiagnosticSink& sink, const Limits& limits,
+    const std::vector<double>& parameterValues)
     : p_(program)
     , sink_(sink)
     , limits_(limits)
+    , parameterValues_(parameterValues)
   {
   }
 
@@ -115,6 +117,7 @@ private:
   const Program& p_;
   DiagnosticSink& sink_;
   const Limits& limits_;
+  const std::vector<double>& parameterValues_;
   std::uint64_t iterations_ = 0;
   std::size_t ops_ = 0;
   std::vector<const Function*> callStack_;
@@ -196,7 +199,8 @@ private:
     {
       return "the coordinates";
     }
-    return "model parameters, which are not known at compile time";
+    return "model parameters, which are not known at compile time (give their values when reading "
+           "the model, e.g. `ictk ... --params`, to specialise it)";
   }
 
   double constant(const Val& v, const ExprNode& at, const std::string& what)
@@ -1550,9 +1554,20 @@ HyperFunModel Compiler::run(const std::string& function)
   {
     Var a;
     a.isArray = true;
+    // With values given, the parameters are constants: the model is specialised, and parameters
+    // may then stand where HyperFun's library needs numbers (a radius, a centre).
+    const bool specialise = !parameterValues_.empty();
+    if (specialise && parameterValues_.size() < static_cast<std::size_t>(model->params[1].size))
+    {
+      sink_.error(model->params[1].line, model->params[1].column,
+        "the model has " + std::to_string(model->params[1].size) + " parameter(s) but " +
+          std::to_string(parameterValues_.size()) + " value(s) were given");
+      return out;
+    }
     for (int i = 0; i < model->params[1].size; ++i)
     {
-      a.items.push_back(Expr::parameter(static_cast<std::uint32_t>(i)));
+      a.items.push_back(specialise ? Expr(parameterValues_[static_cast<std::size_t>(i)])
+                                   : Expr::parameter(static_cast<std::uint32_t>(i)));
     }
     a.set.assign(a.items.size(), 1);
     f.vars[model->params[1].name] = std::move(a);
@@ -1618,10 +1633,10 @@ HyperFunModel Compiler::run(const std::string& function)
 
 } // namespace
 
-HyperFunModel compile(
-  const Program& program, DiagnosticSink& sink, const std::string& function, const Limits& limits)
+HyperFunModel compile(const Program& program, DiagnosticSink& sink, const std::string& function,
+  const Limits& limits, const std::vector<double>& parameterValues)
 {
-  Compiler c(program, sink, limits);
+  Compiler c(program, sink, limits, parameterValues);
   return c.run(function);
 }
 

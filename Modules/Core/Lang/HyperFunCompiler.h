@@ -13,8 +13,10 @@ namespace ictk::lang::hf
 {
 
 /// Compiles the function named `function` (lower-cased comparison), or the last one when empty.
-/// Errors go to `sink`; the result is meaningful only when the sink stays empty.
-HyperFunModel compile(
-  const Program& program, DiagnosticSink& sink, const std::string& function, const Limits& limits);
+/// With `parameterValues`, the parameter array holds those constants (a specialised model);
+/// otherwise it holds parameter slots. Errors go to `sink`; the result is meaningful only when the
+/// sink stays empty.
+HyperFunModel compile(const Program& program, DiagnosticSink& sink, const std::string& function,
+  const Limits& limits, const std::vector<double>& parameterValues = {});
 
 } // namespace ictk::lang::hf

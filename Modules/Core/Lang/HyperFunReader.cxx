@@ -9,7 +9,7 @@ namespace ictk::lang
 {
 
 HyperFunModel readHyperFun(const std::string& text, const std::string& fileName,
-  const std::string& function, const Limits& limits)
+  const std::string& function, const Limits& limits, const std::vector<double>& parameterValues)
 {
   hf::SourceText source(text, fileName);
   hf::DiagnosticSink sink(source, limits.maxDiagnostics > 0 ? limits.maxDiagnostics : 1);
@@ -27,7 +27,7 @@ HyperFunModel readHyperFun(const std::string& text, const std::string& fileName,
   {
     throw ParseError(std::move(sink.diagnostics()));
   }
-  HyperFunModel model = hf::compile(program, sink, function, limits);
+  HyperFunModel model = hf::compile(program, sink, function, limits, parameterValues);
   if (!sink.empty())
   {
     throw ParseError(std::move(sink.diagnostics()));
@@ -35,8 +35,8 @@ HyperFunModel readHyperFun(const std::string& text, const std::string& fileName,
   return model;
 }
 
-HyperFunModel readHyperFunFile(
-  const std::string& path, const std::string& function, const Limits& limits)
+HyperFunModel readHyperFunFile(const std::string& path, const std::string& function,
+  const Limits& limits, const std::vector<double>& parameterValues)
 {
   auto fail = [&](const std::string& message)
   {
@@ -68,7 +68,7 @@ HyperFunModel readHyperFunFile(
   {
     throw fail("cannot read the file");
   }
-  return readHyperFun(text, path, function, limits);
+  return readHyperFun(text, path, function, limits, parameterValues);
 }
 
 } // namespace ictk::lang

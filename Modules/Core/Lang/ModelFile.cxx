@@ -159,13 +159,14 @@ bool isModelFile(const std::string& path)
   return formatOf(path) != Format::Unknown;
 }
 
-ModelFile loadModelFile(const std::string& path, const Limits& limits)
+ModelFile loadModelFile(
+  const std::string& path, const Limits& limits, const std::vector<double>& parameterValues)
 {
   switch (formatOf(path))
   {
     case Format::HyperFun:
     {
-      HyperFunModel hf = readHyperFunFile(path, {}, limits);
+      HyperFunModel hf = readHyperFunFile(path, {}, limits, parameterValues);
       return ModelFile{ std::move(hf.name), hf.parameterCount, std::move(hf.model), std::nullopt };
     }
     case Format::Xml:

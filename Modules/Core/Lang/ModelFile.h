@@ -8,6 +8,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace ictk::lang
 {
@@ -24,8 +25,10 @@ struct ModelFile
 /// True for paths ending in .hf or .xml (case-insensitive).
 bool isModelFile(const std::string& path);
 /// Opens a .hf or .xml file; throws ParseError (diagnostics name the file) or
-/// std::invalid_argument for an unknown extension.
-ModelFile loadModelFile(const std::string& path, const Limits& limits = {});
+/// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model
+/// (see readHyperFun); an XML model keeps its parameter slots.
+ModelFile loadModelFile(const std::string& path, const Limits& limits = {},
+  const std::vector<double>& parameterValues = {});
 /// Saves as .hf or .xml by extension, through a temporary file renamed on success.
 void saveModelFile(const ModelFile& model, const std::string& path);
 
