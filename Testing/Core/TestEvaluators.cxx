@@ -77,13 +77,13 @@ Expr randomTree(Random& rng, int depth, bool smooth)
   const Expr c = randomTree(rng, depth - 1, smooth);
   static const Opcode unary[] = { Opcode::Neg, Opcode::Abs, Opcode::Sqrt, Opcode::Square,
     Opcode::Exp, Opcode::Log, Opcode::Sin, Opcode::Cos, Opcode::Tan, Opcode::Asin, Opcode::Acos,
-    Opcode::Atan, Opcode::Sign };
+    Opcode::Atan, Opcode::Sign, Opcode::Floor };
   static const Opcode binary[] = { Opcode::Add, Opcode::Sub, Opcode::Mul, Opcode::Div, Opcode::Min,
     Opcode::Max, Opcode::Pow, Opcode::Atan2 };
   switch (rng.index(4))
   {
     case 0:
-      return Expr::make(unary[rng.index(13)], a);
+      return Expr::make(unary[rng.index(14)], a);
     case 1:
       return select(a, b, c);
     default:

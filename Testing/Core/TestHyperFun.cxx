@@ -528,3 +528,25 @@ TEST(HyperFun, ParametersSpecialiseLibraryArguments)
   expectSameField(m.model.geometry(), frep::sphere({ 0.5, 0, 0 }, 0.8));
   EXPECT_THROW(readHyperFun(text, "p.hf", {}, {}, { 0.8 }), lang::ParseError);
 }
+
+TEST(HyperFun, RoundingFunctionsOnCoordinates)
+{
+  // At (2.7, -1.2, -3.6): floor(2.7) = 2, ceil(-1.2) = -1, int(-3.6) = -3 (towards zero),
+  // frac(2.7) = 2.7 - 2, mod(27, 4) = 3 (27 = 10 * 2.7 rounded, as HyperFun rounds mod's
+  // arguments).
+  const double v = value(
+    "m = floor(x[1]) + ceil(x[2]) + int(x[3]) + frac(x[1]) + mod(x[1] * 10, 4);", 2.7, -1.2, -3.6);
+  EXPECT_DOUBLE_EQ(v, 2.0 - 1.0 - 3.0 + (2.7 - 2.0) + 3.0);
+  // fmod keeps the dividend's sign: mod(-7, 3) = -1; frac(-2.25) = -0.25.
+  EXPECT_DOUBLE_EQ(value("m = mod(x[1] * 10, 3) + frac(x[2]);", -0.7, -2.25, 0), -1.25);
+  // A floor on a coordinate is an opcode, so intervals and pruning still work on the model.
+  const auto g = geometry("m(x[3], a[1]) {\n m = floor(x[1]) - 0.5;\n}\n");
+  frep::IntervalEvaluator interval(frep::Tape::compile(g.function()));
+  frep::Region r;
+  r.axes = { frep::Interval{ 0.2, 0.8 }, frep::Interval{ 0, 0 }, frep::Interval{ 0, 0 },
+    frep::Interval{ 0, 0 } };
+  const frep::Interval range = interval.eval(r);
+  // floor maps [0.2, 0.8] to exactly [0, 0]; the subtraction widens by one ulp each side.
+  EXPECT_NEAR(range.lo, -0.5, 1e-15);
+  EXPECT_NEAR(range.hi, -0.5, 1e-15);
+}

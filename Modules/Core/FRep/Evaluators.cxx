@@ -532,6 +532,9 @@ Interval intervalOp(
     }
     case Opcode::Atan:
       return monotoneIncreasing(std::atan, a);
+    case Opcode::Floor:
+      // Exact: floor of a double is a double, and floor is monotone.
+      return { std::floor(a.lo), std::floor(a.hi), a.maybeNaN };
     case Opcode::Add:
     {
       const bool infMinusInf = (a.hi == inf && b.lo == -inf) || (a.lo == -inf && b.hi == inf);
@@ -688,6 +691,7 @@ ValueGradient gradientOp(
     case Opcode::Atan:
       return chain(v, a, 1 / (1 + x * x));
     case Opcode::Sign:
+    case Opcode::Floor:
       return chain(v, a, 0);
     case Opcode::Add:
       return combine(v, a, 1, b, 1);

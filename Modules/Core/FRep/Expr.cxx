@@ -28,7 +28,7 @@ struct OpcodeInfo
 constexpr OpcodeInfo opcodeTable[] = {
   { "const", 0 }, { "var", 0 }, { "param", 0 }, { "neg", 1 }, { "abs", 1 }, { "sqrt", 1 },
   { "square", 1 }, { "exp", 1 }, { "log", 1 }, { "sin", 1 }, { "cos", 1 }, { "tan", 1 },
-  { "asin", 1 }, { "acos", 1 }, { "atan", 1 }, { "sign", 1 }, { "add", 2 }, { "sub", 2 },
+  { "asin", 1 }, { "acos", 1 }, { "atan", 1 }, { "sign", 1 }, { "floor", 1 }, { "add", 2 }, { "sub", 2 },
   { "mul", 2 }, { "div", 2 }, { "min", 2 }, { "max", 2 }, { "pow", 2 }, { "atan2", 2 },
   { "select", 3 },
 };
@@ -517,6 +517,10 @@ Expr atan2(const Expr& a, const Expr& b)
 Expr sign(const Expr& a)
 {
   return Expr::make(Opcode::Sign, a);
+}
+Expr floor(const Expr& a)
+{
+  return Expr::make(Opcode::Floor, a);
 }
 Expr select(const Expr& condition, const Expr& ifTrue, const Expr& ifFalse)
 {

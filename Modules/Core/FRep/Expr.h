@@ -49,7 +49,8 @@ enum class Opcode : std::uint8_t
   Asin,
   Acos,
   Atan,
-  Sign, ///< -1, 0 or 1
+  Sign,  ///< -1, 0 or 1
+  Floor, ///< the largest integer <= a
 
   // binary
   Add,
@@ -154,6 +155,7 @@ Expr acos(const Expr& a);
 Expr atan(const Expr& a);
 Expr atan2(const Expr& a, const Expr& b);
 Expr sign(const Expr& a);
+Expr floor(const Expr& a);
 /// a^b. An integer constant exponent lowers to a product of squares (exact, and tight under
 /// interval arithmetic); any other exponent becomes a Pow node.
 Expr pow(const Expr& a, const Expr& b);

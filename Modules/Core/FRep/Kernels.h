@@ -59,6 +59,8 @@ inline T applyScalar(Opcode op, T a, T b, T c)
       return std::atan(a);
     case Opcode::Sign:
       return signOp(a);
+    case Opcode::Floor:
+      return std::floor(a);
     case Opcode::Add:
       return a + b;
     case Opcode::Sub:

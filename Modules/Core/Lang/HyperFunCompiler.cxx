@@ -92,6 +92,12 @@ std::string fmt(double v)
   return buf;
 }
 
+/// Rounding towards zero, as modf's integral part (constant arguments fold).
+Expr truncate(const Expr& v)
+{
+  return frep::select(v, frep::floor(v), -frep::floor(-v));
+}
+
 int hfRound(double d)
 {
   // HF_round (int_parse_N.c): nearest, halves upwards.
@@ -605,33 +611,39 @@ private:
       {
         return plain(frep::atan2(a.e, b.e));
       }
-      const double x = constant(a, node(n.kids[0]), "the first argument of mod");
-      const double y = constant(b, node(n.kids[1]), "the second argument of mod");
-      if (!std::isfinite(x) || !std::isfinite(y) || std::fabs(x) > 2e9 || std::fabs(y) > 2e9 ||
-        hfRound(y) == 0)
+      if (a.e.isConstant() && b.e.isConstant())
       {
-        fail(n.line, n.column, "invalid arguments of mod");
+        const double x = a.e.constantValue(), y = b.e.constantValue();
+        if (!std::isfinite(x) || !std::isfinite(y) || std::fabs(x) > 2e9 || std::fabs(y) > 2e9 ||
+          hfRound(y) == 0)
+        {
+          fail(n.line, n.column, "invalid arguments of mod");
+        }
+        // FUNC_mod: fmod of the rounded arguments.
+        return plain(Expr(std::fmod(static_cast<double>(hfRound(x)), hfRound(y))));
       }
-      // FUNC_mod: fmod of the rounded arguments.
-      return plain(Expr(std::fmod(static_cast<double>(hfRound(x)), hfRound(y))));
+      // The same on expressions: HF_round(d) = floor(d + 0.5) and fmod(p, q) = p - q trunc(p / q),
+      // exact for the integers HyperFun allows (|p|, |q| < 2^26 keep p / q away from an integer
+      // by more than its rounding error). A divisor that rounds to 0 gives NaN where HyperFun
+      // stops.
+      const Expr p = frep::floor(a.e + 0.5), q = frep::floor(b.e + 0.5);
+      return plain(p - q * truncate(p / q));
     }
     if (n.name == "ceil" || n.name == "floor" || n.name == "int" || n.name == "frac")
     {
       arity(n, 1);
-      const Val a = eval(f, n.kids[0]);
-      const double v = constant(a, node(n.kids[0]),
-        "the argument of " + n.spelling + " (the FRep kernel has no rounding operation)");
-      double ip = 0;
-      const double fr = std::modf(v, &ip);
-      if (n.name == "ceil")
-      {
-        return plain(Expr(std::ceil(v)));
-      }
+      const Expr v = eval(f, n.kids[0]).e;
+      count(3, n);
       if (n.name == "floor")
       {
-        return plain(Expr(std::floor(v)));
+        return plain(frep::floor(v));
       }
-      return plain(Expr(n.name == "int" ? ip : fr));
+      if (n.name == "ceil")
+      {
+        return plain(-frep::floor(-v));
+      }
+      // modf: the integral part truncates towards zero; the fraction keeps the sign of v.
+      return plain(n.name == "int" ? truncate(v) : v - truncate(v));
     }
     return std::nullopt;
   }

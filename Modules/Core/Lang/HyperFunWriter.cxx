@@ -171,6 +171,8 @@ const char* functionName(Opcode op)
       return "atan";
     case Opcode::Sign:
       return "sign";
+    case Opcode::Floor:
+      return "floor";
     case Opcode::Min:
       return "min";
     case Opcode::Max:
