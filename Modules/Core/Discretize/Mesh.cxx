@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Discretize/Mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+
+namespace ictk::discretize
+{
+namespace
+{
+
+struct UnionFind
+{
+  std::vector<std::uint32_t> parent;
+  explicit UnionFind(std::size_t n)
+    : parent(n)
+  {
+    std::iota(parent.begin(), parent.end(), 0u);
+  }
+  std::uint32_t find(std::uint32_t i)
+  {
+    while (parent[i] != i)
+    {
+      parent[i] = parent[parent[i]];
+      i = parent[i];
+    }
+    return i;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
+};
+
+std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b)
+{
+  return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+}
+
+} // namespace
+
+MeshTopology analyzeTopology(const SurfaceMesh& mesh)
+{
+  MeshTopology t;
+  t.triangles = mesh.triangles.size();
+  // Per edge: the triangles using it and how many traverse it a->b with a < b.
+  struct EdgeUse
+  {
+    std::uint32_t count = 0;
+    std::uint32_t forward = 0;
+    std::uint32_t firstTriangle = 0;
+  };
+  std::unordered_map<std::uint64_t, EdgeUse> edges;
+  std::vector<char> used(mesh.points.size(), 0);
+  UnionFind triangleSets(mesh.triangles.size());
+  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
+  {
+    const auto& tri = mesh.triangles[f];
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+    {
+      ++t.degenerateTriangles;
+      continue;
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      used[a] = 1;
+      EdgeUse& e = edges[edgeKey(a, b)];
+      if (e.count == 0)
+      {
+        e.firstTriangle = f;
+      }
+      else
+      {
+        triangleSets.unite(f, e.firstTriangle);
+      }
+      ++e.count;
+      e.forward += a < b ? 1 : 0;
+    }
+  }
+  t.vertices = static_cast<std::size_t>(std::count(used.begin(), used.end(), 1));
+  t.edges = edges.size();
+  for (const auto& [key, e] : edges)
+  {
+    (void)key;
+    if (e.count == 1)
+    {
+      ++t.boundaryEdges;
+    }
+    else if (e.count > 2)
+    {
+      ++t.nonManifoldEdges;
+    }
+    else if (e.forward != 1)
+    {
+      ++t.inconsistentEdges;
+    }
+  }
+  // A manifold vertex: its incident triangles, linked through shared edges around it, form one
+  // fan. Count fans per vertex with a union-find over the vertex's triangles.
+  std::vector<std::vector<std::uint32_t>> vertexTriangles(mesh.points.size());
+  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
+  {
+    const auto& tri = mesh.triangles[f];
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+    {
+      continue;
+    }
+    for (auto v : tri)
+    {
+      vertexTriangles[v].push_back(f);
+    }
+  }
+  for (std::uint32_t v = 0; v < mesh.points.size(); ++v)
+  {
+    const auto& fan = vertexTriangles[v];
+    if (fan.size() < 2)
+    {
+      continue;
+    }
+    // Triangles around v are linked when they share an edge (v, w).
+    std::map<std::uint32_t, std::vector<std::size_t>> byOther;
+    for (std::size_t i = 0; i < fan.size(); ++i)
+    {
+      for (auto w : mesh.triangles[fan[i]])
+      {
+        if (w != v)
+        {
+          byOther[w].push_back(i);
+        }
+      }
+    }
+    UnionFind local(fan.size());
+    for (const auto& [w, list] : byOther)
+    {
+      (void)w;
+      for (std::size_t i = 1; i < list.size(); ++i)
+      {
+        local.unite(static_cast<std::uint32_t>(list[0]), static_cast<std::uint32_t>(list[i]));
+      }
+    }
+    std::size_t fans = 0;
+    for (std::uint32_t i = 0; i < fan.size(); ++i)
+    {
+      fans += local.find(i) == i ? 1 : 0;
+    }
+    if (fans > 1)
+    {
+      ++t.nonManifoldVertices;
+    }
+  }
+  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
+  {
+    const auto& tri = mesh.triangles[f];
+    if (!(tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) && triangleSets.find(f) == f)
+    {
+      ++t.components;
+    }
+  }
+  t.eulerCharacteristic = static_cast<long>(t.vertices) - static_cast<long>(t.edges) +
+    static_cast<long>(t.triangles - t.degenerateTriangles);
+  return t;
+}
+
+namespace
+{
+Point3 sub(const Point3& a, const Point3& b)
+{
+  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
+}
+Point3 cross(const Point3& a, const Point3& b)
+{
+  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+}
+} // namespace
+
+double surfaceArea(const SurfaceMesh& mesh)
+{
+  double area = 0;
+  for (const auto& tri : mesh.triangles)
+  {
+    const Point3 n = cross(
+      sub(mesh.points[tri[1]], mesh.points[tri[0]]), sub(mesh.points[tri[2]], mesh.points[tri[0]]));
+    area += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  }
+  return area;
+}
+
+double enclosedVolume(const SurfaceMesh& mesh)
+{
+  double volume = 0;
+  for (const auto& tri : mesh.triangles)
+  {
+    const Point3& a = mesh.points[tri[0]];
+    const Point3 n = cross(mesh.points[tri[1]], mesh.points[tri[2]]);
+    volume += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
+  }
+  return volume;
+}
+
+} // namespace ictk::discretize

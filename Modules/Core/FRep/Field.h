@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// A scalar field of E^3 at a fixed time, whatever represents it (a compiled FRep tape, a voxel
+// grid, a combination of cells). Discretisers and validators are written against this interface,
+// so every cell kind gets the same meshing, tracing and checking code (libfive's split of a shape
+// from its per-thread evaluators).
+//
+// A Field is immutable and shared between threads. Each thread asks it for its own
+// FieldEvaluator, which holds scratch memory and is not thread safe.
+
+#include "FRep/Interval.h"
+#include "FRep/Tape.h"
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace ictk::frep
+{
+
+using Point3 = std::array<double, 3>;
+
+/// An axis-aligned box of E^3.
+struct Box3
+{
+  Point3 lo{ 0, 0, 0 };
+  Point3 hi{ 0, 0, 0 };
+  Point3 centre() const
+  {
+    return { 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]) };
+  }
+  bool valid() const { return lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]; }
+};
+
+class FieldEvaluator
+{
+public:
+  virtual ~FieldEvaluator() = default;
+  /// f at n points given as separate coordinate arrays.
+  virtual void values(
+    const double* x, const double* y, const double* z, double* out, std::size_t n) = 0;
+  double value(const Point3& p)
+  {
+    double v = 0;
+    values(&p[0], &p[1], &p[2], &v, 1);
+    return v;
+  }
+  /// An enclosure of f over the box (every non-NaN value lies in it; maybeNaN as Interval says).
+  virtual Interval bound(const Box3& box) = 0;
+  /// f and its gradient at p.
+  virtual double gradient(const Point3& p, Point3& grad) = 0;
+  /// An evaluator that gives the same values as this one inside `box` and may be cheaper there
+  /// (a tape pruned by interval arithmetic). nullptr when nothing is gained: keep using this one.
+  virtual std::unique_ptr<FieldEvaluator> narrowed(const Box3& box)
+  {
+    (void)box;
+    return nullptr;
+  }
+};
+
+class Field
+{
+public:
+  virtual ~Field() = default;
+  virtual std::unique_ptr<FieldEvaluator> evaluator() const = 0;
+};
+using FieldPtr = std::shared_ptr<const Field>;
+
+/// The field of a tape's first output at time `time` (x, y, z vary; t fixed) with the given
+/// parameter values. The evaluators prune the tape by interval arithmetic in narrowed().
+FieldPtr tapeField(TapePtr tape, double time = 0, std::vector<double> parameters = {});
+
+/// g(x) = -f(x): the complement of a solid, or a cell's inside flipped.
+FieldPtr negatedField(FieldPtr f);
+/// min / max of several fields: the intersection / union of their solids (exact in intervals).
+FieldPtr minField(std::vector<FieldPtr> fields);
+FieldPtr maxField(std::vector<FieldPtr> fields);
+
+} // namespace ictk::frep
