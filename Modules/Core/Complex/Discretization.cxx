@@ -1,0 +1,302 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Complex/Discretization.h"
+
+#include "Complex/Attributes.h"
+#include "Discretize/Curves.h"
+#include "Discretize/Patches.h"
+#include "Discretize/Points.h"
+#include "Discretize/Surface.h"
+#include "FRep/Sampling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace ictk::complex
+{
+namespace
+{
+
+using discretize::CurveSet;
+using discretize::PointSet;
+using discretize::SurfaceMesh;
+
+Box3 padded(const Box3& b, double margin)
+{
+  Box3 out = b;
+  for (int a = 0; a < 3; ++a)
+  {
+    out.lo[a] -= margin;
+    out.hi[a] += margin;
+  }
+  return out;
+}
+
+frep::FieldPtr intersection(const std::vector<frep::FieldPtr>& fields)
+{
+  return fields.size() == 1 ? fields[0] : frep::minField(fields);
+}
+
+const frep::FieldPtr& zField()
+{
+  static const frep::FieldPtr z = frep::tapeField(frep::Tape::compile(frep::Expr::z()));
+  return z;
+}
+
+/// The boundary faces of a tetrahedral solid, oriented away from their tetrahedron.
+SurfaceMesh tetrahedraBoundary(const ExplicitGeometry& g)
+{
+  std::map<std::array<std::uint32_t, 3>, std::pair<int, std::array<std::uint32_t, 3>>> faces;
+  for (const auto& t : g.tetrahedra)
+  {
+    const std::array<std::array<int, 4>, 4> local = { { { 0, 1, 2, 3 }, { 0, 1, 3, 2 },
+      { 0, 2, 3, 1 }, { 1, 2, 3, 0 } } };
+    for (const auto& f : local)
+    {
+      std::array<std::uint32_t, 3> face = { t[f[0]], t[f[1]], t[f[2]] };
+      // Orient the face so that the opposite vertex is behind it.
+      const Point3& a = g.points[face[0]];
+      const Point3& b = g.points[face[1]];
+      const Point3& c = g.points[face[2]];
+      const Point3& d = g.points[t[f[3]]];
+      const Point3 ab{ b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+      const Point3 ac{ c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+      const Point3 ad{ d[0] - a[0], d[1] - a[1], d[2] - a[2] };
+      const double volume = ab[0] * (ac[1] * ad[2] - ac[2] * ad[1]) -
+        ab[1] * (ac[0] * ad[2] - ac[2] * ad[0]) + ab[2] * (ac[0] * ad[1] - ac[1] * ad[0]);
+      if (volume > 0)
+      {
+        std::swap(face[1], face[2]);
+      }
+      std::array<std::uint32_t, 3> key = face;
+      std::sort(key.begin(), key.end());
+      auto& entry = faces[key];
+      ++entry.first;
+      entry.second = face;
+    }
+  }
+  SurfaceMesh mesh;
+  mesh.points = g.points;
+  for (const auto& [key, entry] : faces)
+  {
+    (void)key;
+    if (entry.first == 1)
+    {
+      mesh.triangles.push_back(entry.second);
+    }
+  }
+  return mesh;
+}
+
+void discretizeExplicit(const Cell& c, const ExplicitGeometry& g, CellMesh& out)
+{
+  switch (c.dimension)
+  {
+    case 0:
+      out.points.points = g.points;
+      break;
+    case 1:
+      out.curves.points = g.points;
+      out.curves.lines = g.polylines;
+      break;
+    case 2:
+      out.surface.points = g.points;
+      out.surface.triangles = g.triangles;
+      break;
+    default:
+      out.surface = tetrahedraBoundary(g);
+  }
+}
+
+discretize::SurfaceOptions surfaceOptions(const DiscretizationOptions& o)
+{
+  discretize::SurfaceOptions s;
+  s.featureSize = o.featureSize;
+  s.threads = o.threads;
+  return s;
+}
+
+void discretizeImplicit(
+  const Cell& c, const ImplicitGeometry& g, const DiscretizationOptions& o, CellMesh& out)
+{
+  const Box3 box = padded(g.bounds, 2 * o.featureSize);
+  switch (c.dimension)
+  {
+    case 3:
+      out.surface = discretize::contourSurface(*intersection(g.inside), box, surfaceOptions(o));
+      break;
+    case 2:
+    {
+      SurfaceMesh carrier = discretize::contourSurface(*g.carriers[0], box, surfaceOptions(o));
+      if (g.inside.empty())
+      {
+        out.surface = std::move(carrier);
+      }
+      else
+      {
+        discretize::TrimOptions trim;
+        trim.tolerance = o.tolerance;
+        out.surface = discretize::trimSurface(carrier, *g.carriers[0], g.inside, trim);
+      }
+      break;
+    }
+    case 1:
+    {
+      discretize::CurveOptions curve;
+      curve.step = o.featureSize;
+      curve.tolerance = o.tolerance;
+      out.curves = discretize::traceCurve(*g.carriers[0], *g.carriers[1], g.inside, box, curve);
+      break;
+    }
+    default:
+    {
+      discretize::PointOptions points;
+      points.tolerance = o.tolerance;
+      points.minBoxSize = o.featureSize / 8;
+      PointSet found =
+        discretize::solvePoints(*g.carriers[0], *g.carriers[1], *g.carriers[2], box, points);
+      out.points = discretize::keepInside(found, g.inside, o.tolerance);
+    }
+  }
+}
+
+void discretizeMapped(
+  const Cell& c, const MappedGeometry& g, const DiscretizationOptions& o, CellMesh& out)
+{
+  Box3 uv = g.uvBounds;
+  uv.lo[2] = -1;
+  uv.hi[2] = 1;
+  // The (u, v) meshing step: the feature size divided by how much h stretches the plane.
+  const double step = o.featureSize;
+  switch (c.dimension)
+  {
+    case 2:
+    {
+      discretize::RegionOptions region;
+      region.size = step;
+      region.tolerance = o.tolerance;
+      out.surface = discretize::triangulateRegion2D(*intersection(g.inside), uv, region);
+      discretize::mapToSpace(out.surface, *g.map[0], *g.map[1], *g.map[2]);
+      break;
+    }
+    case 1:
+    {
+      discretize::CurveOptions curve;
+      curve.step = step;
+      curve.tolerance = o.tolerance;
+      out.curves = discretize::traceCurve2D(*g.carriers[0], g.inside, uv, curve);
+      discretize::mapToSpace(out.curves, *g.map[0], *g.map[1], *g.map[2]);
+      break;
+    }
+    default:
+    {
+      discretize::PointOptions points;
+      points.tolerance = o.tolerance;
+      points.minBoxSize = step / 8;
+      PointSet found =
+        discretize::solvePoints(*g.carriers[0], *g.carriers[1], *zField(), uv, points);
+      out.points = discretize::keepInside(found, g.inside, o.tolerance);
+      discretize::mapToSpace(out.points, *g.map[0], *g.map[1], *g.map[2]);
+    }
+  }
+}
+
+double defaultFeatureSize(const Complex& complex)
+{
+  const Box3 b = complexBounds(complex);
+  double side = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    side = std::max(side, b.hi[a] - b.lo[a]);
+  }
+  return side > 0 && std::isfinite(side) ? side / 64 : 1.0 / 64;
+}
+
+} // namespace
+
+CellMesh discretizeCell(const Complex& complex, CellId id, const DiscretizationOptions& options)
+{
+  const Cell& c = complex.cell(id);
+  DiscretizationOptions o = options;
+  if (!(o.featureSize > 0))
+  {
+    o.featureSize = defaultFeatureSize(complex);
+  }
+  CellMesh out;
+  out.cell = id;
+  out.dimension = c.dimension;
+  if (const auto* g = std::get_if<ExplicitGeometry>(&c.geometry))
+  {
+    discretizeExplicit(c, *g, out);
+  }
+  else if (const auto* m = std::get_if<MappedGeometry>(&c.geometry))
+  {
+    discretizeMapped(c, *m, o, out);
+  }
+  else
+  {
+    discretizeImplicit(c, std::get<ImplicitGeometry>(c.geometry), o, out);
+  }
+  for (const auto& binding : c.attributes)
+  {
+    appendAttribute(binding, out.vertices(), out.pointData());
+  }
+  return out;
+}
+
+ComplexMesh discretizeComplex(const Complex& complex, const DiscretizationOptions& options)
+{
+  ComplexMesh mesh;
+  DiscretizationOptions o = options;
+  if (!(o.featureSize > 0))
+  {
+    o.featureSize = defaultFeatureSize(complex);
+  }
+  mesh.featureSize = o.featureSize;
+  const std::vector<CellId> ids = complex.cellIds();
+  std::size_t done = 0;
+  for (CellId id : ids)
+  {
+    mesh.cells.push_back(discretizeCell(complex, id, o));
+    ++done;
+    if (o.progress && !o.progress(0.9 * double(done) / double(ids.size())))
+    {
+      throw frep::Cancelled();
+    }
+  }
+  // Declared attributes a cell does not bind are resolved by priority among the cells that hold
+  // each point, or take their defaults, so that every output point carries every attribute.
+  if (!complex.attributes().empty())
+  {
+    AttributeLookup lookup(complex, mesh, 0.25 * o.featureSize);
+    for (CellMesh& m : mesh.cells)
+    {
+      const Cell& c = complex.cell(m.cell);
+      for (const auto& [name, defaults] : complex.attributes())
+      {
+        const bool bound = std::any_of(c.attributes.begin(), c.attributes.end(),
+          [&](const AttributeBinding& b) { return b.attribute == name; });
+        if (bound)
+        {
+          continue;
+        }
+        discretize::PointArray array;
+        array.name = name;
+        array.components = defaults.components;
+        for (const Point3& p : m.vertices())
+        {
+          const auto v = lookup.value(name, p).value;
+          array.values.insert(array.values.end(), v.begin(), v.end());
+        }
+        m.pointData().push_back(std::move(array));
+      }
+    }
+  }
+  if (o.progress && !o.progress(1.0))
+  {
+    throw frep::Cancelled();
+  }
+  return mesh;
+}
+
+} // namespace ictk::complex
