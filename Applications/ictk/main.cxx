@@ -9,6 +9,7 @@
 // Every user error ends in one line "ictk: error: ..." on stderr and exit code 2; nothing is
 // left half-written (outputs go to a temporary file in the target folder, renamed on success).
 
+#include "ComplexCommands.h"
 #include "FRep/Bounds.h"
 #include "FRep/Evaluators.h"
 #include "FRep/Hypervolume.h"
@@ -1089,11 +1090,35 @@ int Run(int argc, char** argv)
   convert->add_option("output", convertOptions.Output, "The .hf or .xml file to write")->required();
 
   GridCommandOptions meshOptions;
+  double meshFeatureSize = 0;
   CLI::App* mesh = app.add_subcommand("mesh",
-    "Extract the surface f = 0 on a uniform grid (Flying Edges) as .vtp, .stl, .ply or .obj");
+    "Extract the surface f = 0 on a uniform grid (Flying Edges) as .vtp, .stl, .ply or .obj, "
+    "or discretise a complex (.json) by cell dimension into .vtpc or .vtm");
   meshOptions.AddTo(mesh, 128);
-  mesh->add_option("-o,--output", meshOptions.Output, "Output surface (.vtp, .stl, .ply, .obj)")
+  mesh
+    ->add_option("-o,--output", meshOptions.Output,
+      "Output surface (.vtp, .stl, .ply, .obj) or complex (.vtpc, .vtm)")
     ->required();
+  mesh->add_option("--feature-size", meshFeatureSize,
+    "Complexes: mesh edge length and curve step (default: 1/64 of the complex's size)");
+
+  ictk::cli::ComplexOptions infoOptions;
+  CLI::App* info = app.add_subcommand(
+    "info", "List the cells, relations and attributes of a complex (.json) or model");
+  info->add_option("model", infoOptions.Model, "A .json complex or a .hf / .xml model")->required();
+  info->add_flag("--json", infoOptions.Json, "Print a JSON object");
+
+  ictk::cli::ComplexOptions validateOptions;
+  CLI::App* validate = app.add_subcommand("validate",
+    "Check every declared boundary and containment pair against the geometry; exit 1 when one "
+    "is violated");
+  validate->add_option("model", validateOptions.Model, "A .json complex")->required();
+  validate->add_option("--feature-size", validateOptions.FeatureSize,
+    "Discretisation step (default: 1/64 of the complex's size)");
+  validate->add_option("--tolerance", validateOptions.Tolerance,
+    "Distance within which a point counts as on a set (default: a quarter of the step)");
+  validate->add_option("--threads", validateOptions.Threads, "Threads (default: all cores)");
+  validate->add_flag("--json", validateOptions.Json, "Print a JSON report");
 
   try
   {
@@ -1124,8 +1149,26 @@ int Run(int argc, char** argv)
   {
     return RunEval(evalOptions);
   }
+  if (*info)
+  {
+    return ictk::cli::RunInfo(infoOptions);
+  }
+  if (*validate)
+  {
+    return ictk::cli::RunValidate(validateOptions);
+  }
   if (*mesh)
   {
+    if (ictk::cli::IsComplexInput(meshOptions.Model) ||
+      ictk::cli::IsComplexOutput(meshOptions.Output))
+    {
+      ictk::cli::ComplexOptions o;
+      o.Model = meshOptions.Model;
+      o.Output = meshOptions.Output;
+      o.FeatureSize = meshFeatureSize;
+      o.Threads = meshOptions.Threads;
+      return ictk::cli::RunComplexMesh(o);
+    }
     return RunMesh(meshOptions);
   }
   if (*convert)

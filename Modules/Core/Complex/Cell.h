@@ -105,6 +105,8 @@ struct Cell
 {
   CellId id = 0; ///< assigned by Complex::addCell: cells are enumerated
   std::string name;
+  /// What the cell stands for ("receptacle"), for reports and viewers.
+  std::string description;
   CellKind kind = CellKind::FRep;
   int dimension = 3;
   CellGeometry geometry;

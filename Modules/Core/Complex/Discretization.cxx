@@ -2,10 +2,7 @@
 #include "Complex/Discretization.h"
 
 #include "Complex/Attributes.h"
-#include "Discretize/Curves.h"
-#include "Discretize/Patches.h"
-#include "Discretize/Points.h"
-#include "Discretize/Surface.h"
+#include "Discretize/Contour.h"
 #include "FRep/Sampling.h"
 
 #include <algorithm>
@@ -108,54 +105,51 @@ void discretizeExplicit(const Cell& c, const ExplicitGeometry& g, CellMesh& out)
   }
 }
 
-discretize::SurfaceOptions surfaceOptions(const DiscretizationOptions& o)
+discretize::ContourOptions contourOptions(const DiscretizationOptions& o, bool solid)
 {
-  discretize::SurfaceOptions s;
-  s.featureSize = o.featureSize;
-  s.threads = o.threads;
-  return s;
+  discretize::ContourOptions c;
+  c.featureSize = o.featureSize;
+  c.threads = o.threads;
+  c.closeAtBox = solid;
+  return c;
 }
 
 void discretizeImplicit(
   const Cell& c, const ImplicitGeometry& g, const DiscretizationOptions& o, CellMesh& out)
 {
+  discretize::ProjectionOptions projection;
+  projection.tolerance = o.tolerance;
+  // Carriers are meshed a little beyond the cell's box, so that trimming, not the box, makes
+  // the cell's edges.
   const Box3 box = padded(g.bounds, 2 * o.featureSize);
   switch (c.dimension)
   {
     case 3:
-      out.surface = discretize::contourSurface(*intersection(g.inside), box, surfaceOptions(o));
+      out.surface =
+        discretize::contourSurface(*intersection(g.inside), g.bounds, contourOptions(o, true));
       break;
     case 2:
     {
-      SurfaceMesh carrier = discretize::contourSurface(*g.carriers[0], box, surfaceOptions(o));
-      if (g.inside.empty())
-      {
-        out.surface = std::move(carrier);
-      }
-      else
-      {
-        discretize::TrimOptions trim;
-        trim.tolerance = o.tolerance;
-        out.surface = discretize::trimSurface(carrier, *g.carriers[0], g.inside, trim);
-      }
+      SurfaceMesh carrier =
+        discretize::contourSurface(*g.carriers[0], box, contourOptions(o, false));
+      out.surface = g.inside.empty()
+        ? std::move(carrier)
+        : discretize::trimSurface(carrier, *g.carriers[0], g.inside, projection);
       break;
     }
     case 1:
     {
-      discretize::CurveOptions curve;
-      curve.step = o.featureSize;
-      curve.tolerance = o.tolerance;
-      out.curves = discretize::traceCurve(*g.carriers[0], *g.carriers[1], g.inside, box, curve);
+      const SurfaceMesh carrier =
+        discretize::contourSurface(*g.carriers[0], box, contourOptions(o, false));
+      out.curves =
+        discretize::curvesOnSurface(carrier, *g.carriers[0], *g.carriers[1], g.inside, projection);
       break;
     }
     default:
     {
-      discretize::PointOptions points;
-      points.tolerance = o.tolerance;
-      points.minBoxSize = o.featureSize / 8;
-      PointSet found =
-        discretize::solvePoints(*g.carriers[0], *g.carriers[1], *g.carriers[2], box, points);
-      out.points = discretize::keepInside(found, g.inside, o.tolerance);
+      const PointSet found = discretize::solvePoints(
+        *g.carriers[0], *g.carriers[1], *g.carriers[2], g.bounds, o.featureSize / 4, projection);
+      out.points = discretize::keepInside(found, g.inside, 1e3 * o.tolerance);
     }
   }
 }
@@ -163,42 +157,39 @@ void discretizeImplicit(
 void discretizeMapped(
   const Cell& c, const MappedGeometry& g, const DiscretizationOptions& o, CellMesh& out)
 {
+  discretize::ProjectionOptions projection;
+  projection.tolerance = o.tolerance;
   Box3 uv = g.uvBounds;
   uv.lo[2] = -1;
   uv.hi[2] = 1;
-  // The (u, v) meshing step: the feature size divided by how much h stretches the plane.
-  const double step = o.featureSize;
+  // The (u, v) step: h stretches the plane, so the feature size is an upper bound of the 3D edge
+  // only where h is no more than an isometry; a quarter of it keeps the mapped mesh fine enough
+  // for the maps of the models in Data/.
+  const double step = o.featureSize / 2;
+  std::vector<Point3>* points = nullptr;
+  std::vector<discretize::PointArray>* data = nullptr;
   switch (c.dimension)
   {
     case 2:
-    {
-      discretize::RegionOptions region;
-      region.size = step;
-      region.tolerance = o.tolerance;
-      out.surface = discretize::triangulateRegion2D(*intersection(g.inside), uv, region);
-      discretize::mapToSpace(out.surface, *g.map[0], *g.map[1], *g.map[2]);
+      out.surface = discretize::triangulateRegion2D(*intersection(g.inside), uv, step);
+      points = &out.surface.points;
+      data = &out.surface.pointData;
       break;
-    }
     case 1:
-    {
-      discretize::CurveOptions curve;
-      curve.step = step;
-      curve.tolerance = o.tolerance;
-      out.curves = discretize::traceCurve2D(*g.carriers[0], g.inside, uv, curve);
-      discretize::mapToSpace(out.curves, *g.map[0], *g.map[1], *g.map[2]);
+      out.curves = discretize::curves2D(*g.carriers[0], g.inside, uv, step, projection);
+      points = &out.curves.points;
+      data = &out.curves.pointData;
       break;
-    }
     default:
     {
-      discretize::PointOptions points;
-      points.tolerance = o.tolerance;
-      points.minBoxSize = step / 8;
-      PointSet found =
-        discretize::solvePoints(*g.carriers[0], *g.carriers[1], *zField(), uv, points);
-      out.points = discretize::keepInside(found, g.inside, o.tolerance);
-      discretize::mapToSpace(out.points, *g.map[0], *g.map[1], *g.map[2]);
+      const PointSet found = discretize::solvePoints(
+        *g.carriers[0], *g.carriers[1], *zField(), uv, step / 4, projection);
+      out.points = discretize::keepInside(found, g.inside, 1e3 * o.tolerance);
+      points = &out.points.points;
+      data = &out.points.pointData;
     }
   }
+  discretize::mapToSpace(*points, *data, *g.map[0], *g.map[1], *g.map[2]);
 }
 
 double defaultFeatureSize(const Complex& complex)

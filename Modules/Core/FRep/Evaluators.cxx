@@ -174,7 +174,7 @@ void BatchEvaluator<T>::setParameters(const std::vector<double>& parameters)
 }
 
 template <typename T>
-void BatchEvaluator<T>::prepare()
+void BatchEvaluator<T>::prepareFull()
 {
   const Tape& tape = *tape_;
   // Full tape: leaves in fixed slots, constants and parameters broadcast once.
@@ -196,6 +196,16 @@ void BatchEvaluator<T>::prepare()
   {
     fill(tape.constantBase() + static_cast<std::uint32_t>(i), tape.constants()[i]);
   }
+  fullReady_ = true;
+}
+
+template <typename T>
+void BatchEvaluator<T>::prepare()
+{
+  const Tape& tape = *tape_;
+  // eval()'s slots are set up on first use: evalRowX alone (grid sampling, rendering) does not
+  // need them, and for a large tape they are most of the set-up cost.
+  fullReady_ = false;
   // Row program along x.
   row_ = tape.rowProgram(1u << static_cast<int>(Axis::X));
   rowStorage_.assign(static_cast<std::size_t>(row_.chunkSlotCount) * ChunkSize, T(0));
@@ -234,6 +244,10 @@ void BatchEvaluator<T>::eval(const T* x, const T* y, const T* z, const T* t, T* 
       throw std::invalid_argument(std::string("BatchEvaluator::eval: the model uses coordinate ") +
         axisName(static_cast<Axis>(a)) + " but no values were given for it");
     }
+  }
+  if (!fullReady_)
+  {
+    prepareFull();
   }
   const std::uint32_t outSlot = tape_->outputs()[0];
   for (std::size_t start = 0; start < n; start += ChunkSize)

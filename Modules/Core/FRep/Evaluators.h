@@ -58,9 +58,11 @@ public:
 
 private:
   void prepare();
+  void prepareFull();
 
   TapePtr tape_;
   std::vector<double> parameters_;
+  bool fullReady_ = false;
   // The x coordinates currently held by the row program's x slot.
   struct RowX
   {

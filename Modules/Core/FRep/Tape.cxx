@@ -19,18 +19,21 @@ std::uint32_t allocateRegisters(const std::vector<SsaOp>& ssa, std::uint32_t fir
   std::vector<std::uint32_t>& slotOfValue)
 {
   constexpr auto never = std::numeric_limits<std::size_t>::max();
+  constexpr auto unused = never - 1;
   // lastUse[v]: index of the last instruction reading value v; pinned values live to the end.
-  std::unordered_map<std::uint32_t, std::size_t> lastUse;
+  // Value ids are dense (below slotOfValue.size()), so a vector is enough: this runs for every
+  // pruned tape, so it must be cheap.
+  std::vector<std::size_t> lastUse(slotOfValue.size(), unused);
   for (std::size_t i = 0; i < ssa.size(); ++i)
   {
     for (int k = 0; k < opcodeArity(ssa[i].op); ++k)
     {
-      lastUse[ssa[i].operand[k]] = i;
+      lastUse.at(ssa[i].operand[k]) = i;
     }
   }
   for (std::uint32_t v : pinned)
   {
-    lastUse[v] = never;
+    lastUse.at(v) = never;
   }
   std::vector<std::uint32_t> freeSlots; // LIFO, so the allocation is deterministic
   std::uint32_t slotCount = firstFree;
@@ -66,8 +69,7 @@ std::uint32_t allocateRegisters(const std::vector<SsaOp>& ssa, std::uint32_t fir
       {
         repeated = repeated || op.operand[j] == v;
       }
-      auto it = lastUse.find(v);
-      if (!repeated && it != lastUse.end() && it->second == i && slotOfValue.at(v) >= firstFree)
+      if (!repeated && lastUse[v] == i && slotOfValue.at(v) >= firstFree)
       {
         freeSlots.push_back(slotOfValue.at(v));
       }
@@ -270,11 +272,20 @@ TapePtr Tape::simplify(const std::vector<Choice>& choices) const
       live[alias[operands[k]]] = true;
     }
   }
+  // Only the constants still read are kept (a pruned tape is often a small part of a large one, and
+  // evaluators set up every constant slot).
   std::vector<std::uint32_t> renumber(leafCount + ssa_.size());
+  std::vector<double> keptConstants;
   for (std::uint32_t v = 0; v < leafCount; ++v)
   {
     renumber[v] = v;
+    if (v >= constantBase() && live[v])
+    {
+      renumber[v] = constantBase() + static_cast<std::uint32_t>(keptConstants.size());
+      keptConstants.push_back(constants_[v - constantBase()]);
+    }
   }
+  const auto newLeafCount = constantBase() + static_cast<std::uint32_t>(keptConstants.size());
   std::vector<TapeSsa> kept;
   for (std::size_t i = 0; i < ssa_.size(); ++i)
   {
@@ -289,7 +300,7 @@ TapePtr Tape::simplify(const std::vector<Choice>& choices) const
       s.b = renumber[alias[s.b]];
     if (opcodeArity(s.op) > 2)
       s.c = renumber[alias[s.c]];
-    renumber[v] = static_cast<std::uint32_t>(leafCount + kept.size());
+    renumber[v] = static_cast<std::uint32_t>(newLeafCount + kept.size());
     kept.push_back(s);
   }
   std::vector<std::uint32_t> outputs;
@@ -297,7 +308,7 @@ TapePtr Tape::simplify(const std::vector<Choice>& choices) const
   {
     outputs.push_back(renumber[alias[v]]);
   }
-  return build(parameterCount_, constants_, std::move(kept), std::move(outputs));
+  return build(parameterCount_, std::move(keptConstants), std::move(kept), std::move(outputs));
 }
 
 RowProgram Tape::rowProgram(std::uint8_t varyingAxes) const

@@ -5,6 +5,7 @@
 
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
+#include "Lang/VmReader.h"
 
 #include <atomic>
 #include <cctype>
@@ -29,7 +30,8 @@ enum class Format
 {
   Unknown,
   HyperFun,
-  Xml
+  Xml,
+  Vm
 };
 
 Format formatOf(const std::string& path)
@@ -47,13 +49,18 @@ Format formatOf(const std::string& path)
   {
     return Format::Xml;
   }
+  if (ext == ".vm")
+  {
+    return Format::Vm;
+  }
   return Format::Unknown;
 }
 
 [[noreturn]] void unknownExtension(const std::string& path)
 {
-  throw std::invalid_argument(
-    "'" + path + "' is not a model file: the extension must be .hf (HyperFun) or .xml (FRep XML)");
+  throw std::invalid_argument("'" + path +
+    "' is not a model file: the extension must be .hf (HyperFun), .xml (FRep XML) or .vm (Fidget "
+    "SSA, read only)");
 }
 
 // A HyperFun body name made from any model name: letters, digits and '_', starting with a letter.
@@ -169,6 +176,15 @@ ModelFile loadModelFile(
       HyperFunModel hf = readHyperFunFile(path, {}, limits, parameterValues);
       return ModelFile{ std::move(hf.name), hf.parameterCount, std::move(hf.model), std::nullopt };
     }
+    case Format::Vm:
+    {
+      // Fidget's SSA benchmark models (read only): negated on import, 2D unless z is used.
+      VmModel vm = readVmFile(path, limits);
+      const frep::Domain domain = (vm.axesUsed & 4u) ? frep::Domain::XYZ : frep::Domain::XY;
+      std::string name = std::filesystem::path(path).stem().string();
+      return ModelFile{ name, 0,
+        frep::Hypervolume(frep::Shape(std::move(vm.function), domain, name)), std::nullopt };
+    }
     case Format::Xml:
     {
       // readFRepXmlFile's checks (readable, size) first, then the full document.
@@ -234,6 +250,8 @@ void saveModelFile(const ModelFile& model, const std::string& path)
       text = writeFRepXmlDocument(
         model.model, model.name.empty() ? "model" : model.name, model.parameterCount, model.bounds);
       break;
+    case Format::Vm:
+      throw std::invalid_argument("cannot save '" + path + "': .vm files are read only");
     default:
       unknownExtension(path);
   }

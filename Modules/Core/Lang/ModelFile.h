@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML).
+// Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML); .vm (Fidget's
+// SSA benchmark format, negated on import) is read only.
 
 #include "FRep/Hypervolume.h"
 #include "Lang/Diagnostics.h"
@@ -22,7 +23,7 @@ struct ModelFile
   std::optional<std::array<double, 6>> bounds;
 };
 
-/// True for paths ending in .hf or .xml (case-insensitive).
+/// True for paths ending in .hf, .xml or .vm (case-insensitive).
 bool isModelFile(const std::string& path);
 /// Opens a .hf or .xml file; throws ParseError (diagnostics name the file) or
 /// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model

@@ -1,0 +1,829 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Lang/ComplexFile.h"
+
+#include "FRep/Tape.h"
+#include "Lang/HyperFun.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace ictk::lang
+{
+namespace
+{
+
+using complex::Cell;
+using complex::CellKind;
+using complex::Complex;
+using frep::Box3;
+using frep::FieldPtr;
+using frep::Point3;
+using Json = nlohmann::json;
+
+/// An error at a known place; collected, then thrown together as a ParseError.
+struct Problem
+{
+  std::string message;
+  std::size_t offset = std::string::npos;
+};
+
+class Reader
+{
+public:
+  Reader(const std::string& text, const std::string& fileName, const Limits& limits)
+    : text_(text)
+    , file_(fileName)
+    , limits_(limits)
+  {
+  }
+
+  Complex read()
+  {
+    Json doc;
+    try
+    {
+      doc = Json::parse(text_);
+    }
+    catch (const Json::parse_error& e)
+    {
+      // nlohmann reports the byte after the error; point at the byte itself.
+      report(std::string("invalid JSON: ") + jsonMessage(e.what()), e.byte > 0 ? e.byte - 1 : 0);
+      throwIfFailed();
+    }
+    if (!doc.is_object())
+    {
+      report("the file must hold a JSON object with \"cells\"", 0);
+      throwIfFailed();
+    }
+    Complex k;
+    k.name = doc.value("name", std::string());
+    time_ = number(doc, "time", 0.0, "the time");
+    readLibrary(doc);
+    readAttributes(doc, k);
+    readCells(doc, k);
+    readRelations(doc, k);
+    throwIfFailed();
+    return k;
+  }
+
+private:
+  static std::string jsonMessage(const std::string& what)
+  {
+    // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..." ->
+    // the part after the position, which we print ourselves.
+    const auto colon = what.find(": ");
+    return colon == std::string::npos ? what : what.substr(colon + 2);
+  }
+
+  void report(const std::string& message, std::size_t offset = std::string::npos)
+  {
+    problems_.push_back({ message, offset });
+  }
+
+  /// The offset of `"key": "value"` in the text, for locating an object by its name.
+  std::size_t locate(const std::string& key, const std::string& value) const
+  {
+    const std::string quoted = "\"" + value + "\"";
+    std::size_t at = 0;
+    while ((at = text_.find(quoted, at)) != std::string::npos)
+    {
+      const std::size_t keyAt = text_.rfind("\"" + key + "\"", at);
+      if (keyAt != std::string::npos &&
+        text_.find_first_not_of(" \t\r\n:", keyAt + key.size() + 2) == at)
+      {
+        return at;
+      }
+      at += quoted.size();
+    }
+    return std::string::npos;
+  }
+
+  Diagnostic diagnostic(const Problem& p) const
+  {
+    Diagnostic d;
+    d.where.file = file_;
+    d.message = p.message;
+    if (p.offset != std::string::npos && p.offset <= text_.size())
+    {
+      const std::size_t lineStart = text_.rfind('\n', p.offset == 0 ? 0 : p.offset - 1);
+      const std::size_t begin = lineStart == std::string::npos || p.offset == 0 ? 0 : lineStart + 1;
+      d.where.line = 1 +
+        static_cast<int>(
+          std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(begin), '\n'));
+      d.where.column = 1 + static_cast<int>(p.offset - begin);
+      const std::size_t end = text_.find('\n', begin);
+      d.sourceLine =
+        text_.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+    }
+    return d;
+  }
+
+  void throwIfFailed()
+  {
+    if (problems_.empty())
+    {
+      return;
+    }
+    std::vector<Diagnostic> all;
+    for (const auto& p : problems_)
+    {
+      all.push_back(diagnostic(p));
+      if (all.size() >= limits_.maxDiagnostics)
+      {
+        break;
+      }
+    }
+    throw ParseError(std::move(all));
+  }
+
+  double number(const Json& j, const char* key, double fallback, const std::string& what)
+  {
+    if (!j.contains(key))
+    {
+      return fallback;
+    }
+    if (!j[key].is_number() || !std::isfinite(j[key].get<double>()))
+    {
+      report(what + " must be a finite number");
+      return fallback;
+    }
+    return j[key].get<double>();
+  }
+
+  // --- the HyperFun library ------------------------------------------------------------------
+  void readLibrary(const Json& doc)
+  {
+    if (doc.contains("hyperfun"))
+    {
+      if (!doc["hyperfun"].is_string())
+      {
+        report("\"hyperfun\" must be a string of HyperFun functions", locateKey("hyperfun"));
+        return;
+      }
+      library_ = doc["hyperfun"].get<std::string>();
+      libraryName_ = file_ + " (hyperfun)";
+    }
+    if (doc.contains("hyperfun_file"))
+    {
+      if (!doc["hyperfun_file"].is_string())
+      {
+        report("\"hyperfun_file\" must be a path", locateKey("hyperfun_file"));
+        return;
+      }
+      const std::string path = resolve(doc["hyperfun_file"].get<std::string>());
+      std::ifstream in(path, std::ios::binary);
+      if (!in)
+      {
+        report("cannot read the HyperFun library '" + path + "'", locateKey("hyperfun_file"));
+        return;
+      }
+      std::ostringstream s;
+      s << in.rdbuf();
+      library_ += "\n" + s.str();
+      libraryName_ = path;
+    }
+  }
+
+  std::size_t locateKey(const std::string& key) const { return text_.find("\"" + key + "\""); }
+
+  std::string resolve(const std::string& path) const
+  {
+    if (!path.empty() && path[0] == '/')
+    {
+      return path;
+    }
+    const auto slash = file_.find_last_of('/');
+    return slash == std::string::npos ? path : file_.substr(0, slash + 1) + path;
+  }
+
+  /// Compiles one HyperFun expression over x[dimensionality] (for mapped cells, with the array
+  /// h = map(x) available), using the library's functions.
+  frep::Expr compile(const std::string& expression, int coordinates, const std::string& where,
+    const std::array<std::string, 3>* map = nullptr)
+  {
+    std::string body;
+    if (map)
+    {
+      body = "  array h[3];\n  h[1] = " + (*map)[0] + ";\n  h[2] = " + (*map)[1] +
+        ";\n  h[3] = " + (*map)[2] + ";\n";
+    }
+    const std::string wrapper = "\nictk_field(x[" + std::to_string(coordinates) + "], a[1])\n{\n" +
+      body + "  ictk_field = " + expression + ";\n}\n";
+    try
+    {
+      lang::HyperFunModel m =
+        readHyperFun(library_ + wrapper, libraryName_.empty() ? file_ : libraryName_, "ictk_field",
+          limits_, std::vector<double>{ 0.0 });
+      return m.model.geometry().function();
+    }
+    catch (const ParseError& e)
+    {
+      // Errors inside the library keep their position; errors in the expression are reported
+      // at the cell, with the expression quoted.
+      std::string detail;
+      for (const auto& d : e.diagnostics())
+      {
+        detail += "\n  " + d.message;
+      }
+      report(where + ": cannot compile '" + expression + "':" + detail, current_);
+      return frep::Expr::constant(-1.0);
+    }
+  }
+
+  FieldPtr field(const frep::Expr& e) { return frep::tapeField(frep::Tape::compile(e), time_); }
+
+  std::vector<std::string> strings(const Json& cell, const char* key, const std::string& where)
+  {
+    std::vector<std::string> out;
+    if (!cell.contains(key))
+    {
+      return out;
+    }
+    const Json& list = cell[key];
+    if (!list.is_array())
+    {
+      report(where + ": \"" + key + "\" must be a list of HyperFun expressions", current_);
+      return out;
+    }
+    for (const auto& item : list)
+    {
+      if (!item.is_string())
+      {
+        report(where + ": every item of \"" + key + "\" must be a string", current_);
+        continue;
+      }
+      out.push_back(item.get<std::string>());
+    }
+    return out;
+  }
+
+  bool point(const Json& j, Point3& p, int size = 3)
+  {
+    if (!j.is_array() || static_cast<int>(j.size()) != size)
+    {
+      return false;
+    }
+    p = { 0, 0, 0 };
+    for (int a = 0; a < size; ++a)
+    {
+      if (!j[a].is_number() || !std::isfinite(j[a].get<double>()))
+      {
+        return false;
+      }
+      p[a] = j[a].get<double>();
+    }
+    return true;
+  }
+
+  bool box(const Json& cell, const char* key, Box3& b, int size, const std::string& where)
+  {
+    if (!cell.contains(key) || !cell[key].is_array() || cell[key].size() != 2 ||
+      !point(cell[key][0], b.lo, size) || !point(cell[key][1], b.hi, size))
+    {
+      report(where + ": \"" + key + "\" must be [[lo...], [hi...]] with " + std::to_string(size) +
+          " finite numbers each",
+        current_);
+      return false;
+    }
+    for (int a = 0; a < size; ++a)
+    {
+      if (b.lo[a] > b.hi[a])
+      {
+        report(where + ": \"" + key + "\" has lo > hi on axis " + std::to_string(a), current_);
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // --- attributes ----------------------------------------------------------------------------
+  void readAttributes(const Json& doc, Complex& k)
+  {
+    if (doc.contains("attributes"))
+    {
+      for (const auto& [name, spec] : doc["attributes"].items())
+      {
+        current_ = locateKey(name);
+        complex::AttributeDefaults d;
+        d.components = spec.value("components", 1);
+        auto values = [&](const char* key)
+        {
+          std::vector<double> v;
+          if (spec.contains(key) && spec[key].is_array())
+          {
+            for (const auto& x : spec[key])
+            {
+              v.push_back(x.is_number() ? x.get<double>() : NAN);
+            }
+          }
+          return v;
+        };
+        d.inside = values("inside");
+        d.outside = values("outside");
+        try
+        {
+          k.declareAttribute(name, d);
+        }
+        catch (const std::exception& e)
+        {
+          report(e.what(), current_);
+        }
+      }
+    }
+    if (doc.contains("attribute_functions"))
+    {
+      for (const auto& [name, spec] : doc["attribute_functions"].items())
+      {
+        current_ = locateKey(name);
+        auto f = std::make_shared<complex::AttributeFunction>();
+        f->name = name;
+        const Json list = spec.is_array() ? spec : Json::array({ spec });
+        for (const auto& component : list)
+        {
+          std::string text =
+            component.is_string() ? component.get<std::string>() : component.dump();
+          f->text.push_back(text);
+          f->components.push_back(field(compile(text, 3, "attribute function '" + name + "'")));
+        }
+        functions_[name] = f;
+      }
+    }
+  }
+
+  void bindAttributes(const Json& cell, Cell& c)
+  {
+    if (!cell.contains("attributes"))
+    {
+      return;
+    }
+    for (const auto& [attribute, spec] : cell["attributes"].items())
+    {
+      const std::string function =
+        spec.is_string() ? spec.get<std::string>() : spec.value("function", std::string());
+      auto it = functions_.find(function);
+      if (it == functions_.end())
+      {
+        report("cell '" + c.name + "': attribute '" + attribute +
+            "' names no attribute function '" + function + "'",
+          current_);
+        continue;
+      }
+      complex::AttributeBinding b;
+      b.attribute = attribute;
+      b.function = it->second;
+      b.priority = spec.is_object() ? spec.value("priority", 0.0) : 0.0;
+      c.attributes.push_back(std::move(b));
+    }
+  }
+
+  // --- cells ---------------------------------------------------------------------------------
+  void readCells(const Json& doc, Complex& k)
+  {
+    if (!doc.contains("cells") || !doc["cells"].is_array())
+    {
+      report("the complex needs a list \"cells\"", 0);
+      return;
+    }
+    for (const auto& spec : doc["cells"])
+    {
+      if (!spec.is_object() || !spec.contains("name") || !spec["name"].is_string())
+      {
+        report("every cell needs a \"name\"", 0);
+        continue;
+      }
+      Cell c;
+      c.name = spec["name"].get<std::string>();
+      c.description = spec.value("description", std::string());
+      current_ = locate("name", c.name);
+      const std::string where = "cell '" + c.name + "'";
+      try
+      {
+        c.kind = complex::kindFromCode(spec.value("kind", std::string("F")));
+      }
+      catch (const std::exception& e)
+      {
+        report(where + ": " + e.what(), current_);
+        continue;
+      }
+      if (!spec.contains("dimension") || !spec["dimension"].is_number_integer())
+      {
+        report(where + ": \"dimension\" (0, 1, 2 or 3) is required", current_);
+        continue;
+      }
+      c.dimension = spec["dimension"].get<int>();
+      const std::size_t before = problems_.size();
+      switch (c.kind)
+      {
+        case CellKind::Point:
+        case CellKind::BRep:
+          readExplicit(spec, c, where);
+          break;
+        case CellKind::MappedFRep:
+          readMapped(spec, c, where);
+          break;
+        case CellKind::Composite:
+        case CellKind::Computed:
+          readDerived(spec, c, k, where);
+          break;
+        case CellKind::Voxel:
+          report(where + ": voxel cells are read by the VTK layer (ictkComplexSource) for now",
+            current_);
+          break;
+        default:
+          readImplicit(spec, c, where);
+      }
+      bindAttributes(spec, c);
+      if (problems_.size() != before)
+      {
+        continue;
+      }
+      try
+      {
+        k.addCell(std::move(c));
+      }
+      catch (const std::exception& e)
+      {
+        report(e.what(), current_);
+      }
+    }
+  }
+
+  void readImplicit(const Json& spec, Cell& c, const std::string& where)
+  {
+    complex::ImplicitGeometry g;
+    box(spec, "bounds", g.bounds, 3, where);
+    g.carrierText = strings(spec, "carriers", where);
+    g.insideText = strings(spec, "inside", where);
+    for (const auto& t : g.carrierText)
+    {
+      g.carriers.push_back(field(compile(t, 3, where)));
+    }
+    for (const auto& t : g.insideText)
+    {
+      g.inside.push_back(field(compile(t, 3, where)));
+    }
+    c.geometry = std::move(g);
+  }
+
+  void readMapped(const Json& spec, Cell& c, const std::string& where)
+  {
+    complex::MappedGeometry g;
+    box(spec, "uv_bounds", g.uvBounds, 2, where);
+    const std::vector<std::string> map = strings(spec, "map", where);
+    if (map.size() != 3)
+    {
+      report(where + ": \"map\" must give h(u, v) as three HyperFun expressions", current_);
+      return;
+    }
+    std::copy(map.begin(), map.end(), g.mapText.begin());
+    for (int a = 0; a < 3; ++a)
+    {
+      g.map[a] = field(compile(map[a], 2, where));
+    }
+    g.carrierText = strings(spec, "carriers", where);
+    g.insideText = strings(spec, "inside", where);
+    for (const auto& t : g.carrierText)
+    {
+      g.carriers.push_back(field(compile(t, 2, where, &g.mapText)));
+    }
+    for (const auto& t : g.insideText)
+    {
+      g.inside.push_back(field(compile(t, 2, where, &g.mapText)));
+    }
+    c.geometry = std::move(g);
+  }
+
+  void readExplicit(const Json& spec, Cell& c, const std::string& where)
+  {
+    complex::ExplicitGeometry g;
+    if (spec.contains("curve"))
+    {
+      readCurve(spec["curve"], g, where);
+    }
+    else if (spec.contains("points") && spec["points"].is_array())
+    {
+      for (const auto& p : spec["points"])
+      {
+        Point3 q;
+        if (!point(p, q))
+        {
+          report(where + ": every point must be [x, y, z] with finite numbers", current_);
+          return;
+        }
+        g.points.push_back(q);
+      }
+    }
+    auto indices = [&](const char* key, auto& out)
+    {
+      if (!spec.contains(key))
+      {
+        return;
+      }
+      for (const auto& item : spec[key])
+      {
+        typename std::decay_t<decltype(out)>::value_type element{};
+        if (!item.is_array())
+        {
+          report(where + ": \"" + key + "\" must be a list of index lists", current_);
+          return;
+        }
+        std::vector<std::uint32_t> list;
+        for (const auto& i : item)
+        {
+          if (!i.is_number_unsigned())
+          {
+            report(where + ": indices in \"" + key + "\" must be non-negative integers", current_);
+            return;
+          }
+          list.push_back(i.get<std::uint32_t>());
+        }
+        if constexpr (std::is_same_v<decltype(element), std::vector<std::uint32_t>>)
+        {
+          element = list;
+        }
+        else
+        {
+          if (list.size() != element.size())
+          {
+            report(where + ": every item of \"" + key + "\" needs " +
+                std::to_string(element.size()) + " indices",
+              current_);
+            return;
+          }
+          std::copy(list.begin(), list.end(), element.begin());
+        }
+        out.push_back(element);
+      }
+    };
+    indices("polylines", g.polylines);
+    indices("triangles", g.triangles);
+    indices("tetrahedra", g.tetrahedra);
+    c.geometry = std::move(g);
+  }
+
+  /// A Bezier curve of any degree, sampled by de Casteljau's algorithm.
+  void readCurve(const Json& curve, complex::ExplicitGeometry& g, const std::string& where)
+  {
+    std::vector<Point3> control;
+    if (curve.contains("bezier") && curve["bezier"].is_array())
+    {
+      for (const auto& p : curve["bezier"])
+      {
+        Point3 q;
+        if (!point(p, q))
+        {
+          report(where + ": Bezier control points must be [x, y, z]", current_);
+          return;
+        }
+        control.push_back(q);
+      }
+    }
+    if (control.size() < 2)
+    {
+      report(where + ": \"curve\" needs \"bezier\" with at least two control points", current_);
+      return;
+    }
+    const int samples = curve.value("samples", 64);
+    if (samples < 1 || samples > 1000000)
+    {
+      report(where + ": \"samples\" must be between 1 and 1000000", current_);
+      return;
+    }
+    std::vector<std::uint32_t> line;
+    for (int i = 0; i <= samples; ++i)
+    {
+      const double t = double(i) / samples;
+      std::vector<Point3> work = control;
+      for (std::size_t level = work.size() - 1; level > 0; --level)
+      {
+        for (std::size_t j = 0; j < level; ++j)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            work[j][a] = (1 - t) * work[j][a] + t * work[j + 1][a];
+          }
+        }
+      }
+      line.push_back(static_cast<std::uint32_t>(g.points.size()));
+      g.points.push_back(work[0]);
+    }
+    g.polylines.push_back(std::move(line));
+  }
+
+  /// C cells (a set operation on 3D cells) and T cells (the boundaries of some cells, trimmed by
+  /// the insides of others).
+  void readDerived(const Json& spec, Cell& c, const Complex& k, const std::string& where)
+  {
+    auto solids = [&](const char* key)
+    {
+      std::vector<const Cell*> out;
+      if (!spec.contains(key))
+      {
+        return out;
+      }
+      for (const auto& name : spec[key])
+      {
+        const Cell* operand = name.is_string() ? k.findCell(name.get<std::string>()) : nullptr;
+        const auto* g =
+          operand ? std::get_if<complex::ImplicitGeometry>(&operand->geometry) : nullptr;
+        if (!g || operand->dimension != 3)
+        {
+          report(where + ": \"" + key + "\" must name 3D implicit cells defined earlier (" +
+              name.dump() + " is not one)",
+            current_);
+          continue;
+        }
+        c.operands.push_back(operand->id);
+        out.push_back(operand);
+      }
+      return out;
+    };
+    auto solidField = [](const Cell* cell)
+    {
+      const auto& g = std::get<complex::ImplicitGeometry>(cell->geometry);
+      return g.inside.size() == 1 ? g.inside[0] : frep::minField(g.inside);
+    };
+    complex::ImplicitGeometry g;
+    const double inf = std::numeric_limits<double>::infinity();
+    g.bounds = { { -inf, -inf, -inf }, { inf, inf, inf } };
+    auto clip = [&](const Cell* cell)
+    {
+      const Box3 b = cell->bounds();
+      for (int a = 0; a < 3; ++a)
+      {
+        g.bounds.lo[a] = std::max(g.bounds.lo[a], b.lo[a]);
+        g.bounds.hi[a] = std::min(g.bounds.hi[a], b.hi[a]);
+      }
+    };
+    if (c.kind == CellKind::Composite)
+    {
+      const std::string op = spec.value("operation", std::string());
+      const auto operands = solids("operands");
+      if (operands.size() < 2)
+      {
+        report(where + ": a composite cell needs \"operands\" naming two or more cells", current_);
+        return;
+      }
+      if (op == "union")
+      {
+        std::vector<FieldPtr> fields;
+        g.bounds = operands[0]->bounds();
+        for (const Cell* o : operands)
+        {
+          fields.push_back(solidField(o));
+          const Box3 b = o->bounds();
+          for (int a = 0; a < 3; ++a)
+          {
+            g.bounds.lo[a] = std::min(g.bounds.lo[a], b.lo[a]);
+            g.bounds.hi[a] = std::max(g.bounds.hi[a], b.hi[a]);
+          }
+        }
+        g.inside.push_back(frep::maxField(fields));
+      }
+      else if (op == "intersection" || op == "difference")
+      {
+        for (std::size_t i = 0; i < operands.size(); ++i)
+        {
+          const FieldPtr f = solidField(operands[i]);
+          const bool subtract = op == "difference" && i > 0;
+          g.inside.push_back(subtract ? frep::negatedField(f) : f);
+          if (!subtract)
+          {
+            clip(operands[i]);
+          }
+        }
+      }
+      else
+      {
+        report(where + ": \"operation\" must be union, intersection or difference", current_);
+        return;
+      }
+    }
+    else
+    {
+      for (const Cell* o : solids("boundary_of"))
+      {
+        g.carriers.push_back(solidField(o));
+        clip(o);
+      }
+      for (const Cell* o : solids("inside_of"))
+      {
+        g.inside.push_back(solidField(o));
+        clip(o);
+      }
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      if (!(g.bounds.lo[a] <= g.bounds.hi[a]))
+      {
+        report(where + ": its operands do not overlap, so the cell is empty", current_);
+        return;
+      }
+    }
+    c.geometry = std::move(g);
+  }
+
+  // --- relations -----------------------------------------------------------------------------
+  void readRelations(const Json& doc, Complex& k)
+  {
+    if (!doc.contains("relations"))
+    {
+      return;
+    }
+    for (const char* kind : { "boundary", "containment" })
+    {
+      if (!doc["relations"].contains(kind))
+      {
+        continue;
+      }
+      for (const auto& pair : doc["relations"][kind])
+      {
+        if (!pair.is_array() || pair.size() != 2 || !pair[0].is_string() || !pair[1].is_string())
+        {
+          report(std::string("relations.") + kind + ": every pair must be [\"cell\", \"cell\"]",
+            locateKey(kind));
+          continue;
+        }
+        const std::string a = pair[0].get<std::string>();
+        const std::string b = pair[1].get<std::string>();
+        const std::size_t at = text_.find("\"" + a + "\", \"" + b + "\"");
+        try
+        {
+          if (std::string(kind) == "boundary")
+          {
+            k.addBoundary(k.idOf(a), k.idOf(b));
+          }
+          else
+          {
+            k.addContainment(k.idOf(a), k.idOf(b));
+          }
+        }
+        catch (const std::exception& e)
+        {
+          report(std::string(kind) + " relation (" + a + ", " + b + "): " + e.what(),
+            at == std::string::npos ? locateKey(kind) : at);
+        }
+      }
+    }
+  }
+
+  const std::string& text_;
+  std::string file_;
+  Limits limits_;
+  double time_ = 0;
+  std::string library_;
+  std::string libraryName_;
+  std::map<std::string, complex::AttributeFunctionPtr> functions_;
+  std::vector<Problem> problems_;
+  std::size_t current_ = std::string::npos;
+};
+
+} // namespace
+
+bool isComplexFile(const std::string& path)
+{
+  if (path.size() < 5)
+  {
+    return false;
+  }
+  std::string ext = path.substr(path.size() - 5);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+    [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".json";
+}
+
+complex::Complex readComplexJson(
+  const std::string& text, const std::string& fileName, const Limits& limits)
+{
+  if (text.size() > limits.maxFileBytes)
+  {
+    Diagnostic d;
+    d.where.file = fileName;
+    d.message =
+      "the file is larger than the limit of " + std::to_string(limits.maxFileBytes) + " bytes";
+    throw ParseError({ d });
+  }
+  return Reader(text, fileName, limits).read();
+}
+
+complex::Complex readComplexFile(const std::string& path, const Limits& limits)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+  {
+    Diagnostic d;
+    d.where.file = path;
+    d.message = "cannot open the file";
+    throw ParseError({ d });
+  }
+  std::ostringstream s;
+  s << in.rdbuf();
+  return readComplexJson(s.str(), path, limits);
+}
+
+} // namespace ictk::lang

@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class ictkComplexSource
+ * @brief Discretises an implicit complex and outputs it as a vtkPartitionedDataSetCollection.
+ *
+ * The complex comes from a .json complex file (SetFileName) or, in C++, from SetComplex(). Every
+ * cell is discretised by its dimension (points, traced polylines, trimmed or mapped triangle
+ * patches, boundary surfaces of solids) at FeatureSize, and becomes one partitioned dataset
+ * holding a vtkPolyData whose point data carries every attribute of the complex.
+ *
+ * Each partitioned dataset's field data holds CellId, CellName, CellKind, CellDimension and
+ * CellDescription. The collection's vtkDataAssembly has the nodes
+ *   /dimension_0 .. /dimension_3: the cells by dimension;
+ *   /relations/boundary/<cell>: the cells on the boundary of <cell> (Rb);
+ *   /relations/containment/<cell>: the cells <cell> contains (Rc);
+ *   /relations/coboundary/<cell>, /relations/contained_in/<cell>: the derived inverses;
+ * each node carrying the cell name in its "cell" attribute (node names are made XML-valid).
+ *
+ * Progress is reported per cell; AbortExecute cancels and leaves an empty output. Errors (a bad
+ * file, an invalid relation, a cell that cannot be discretised) are reported with vtkErrorMacro
+ * and the request fails.
+ */
+#pragma once
+
+#include "ictkFiltersComplexModule.h" // export macro
+#include "vtkPartitionedDataSetCollectionAlgorithm.h"
+
+#include <memory> // for std::shared_ptr
+#include <string> // for std::string
+
+class vtkMultiBlockDataSet;
+class vtkPartitionedDataSetCollection;
+
+#ifndef __VTK_WRAP__
+namespace ictk
+{
+namespace complex
+{
+class Complex;
+struct ComplexMesh;
+} // namespace complex
+} // namespace ictk
+#endif
+
+class ICTKFILTERSCOMPLEX_EXPORT ictkComplexSource : public vtkPartitionedDataSetCollectionAlgorithm
+{
+public:
+  static ictkComplexSource* New();
+  vtkTypeMacro(ictkComplexSource, vtkPartitionedDataSetCollectionAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// A .json complex file.
+  vtkSetStdStringFromCharMacro(FileName);
+  vtkGetCharFromStdStringMacro(FileName);
+
+  /// Mesh edge length and curve step in model units; 0 (default) = 1/64 of the complex's size.
+  vtkSetClampMacro(FeatureSize, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(FeatureSize, double);
+
+  /// Threads for the discretisers; 0 = TBB's default. Results do not depend on it.
+  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
+  vtkGetMacro(NumberOfThreads, int);
+
+  /// The cells as a vtkMultiBlockDataSet (blocks per dimension, then one per cell, named), for
+  /// consumers that do not read partitioned dataset collections (.vtm files).
+  static void ToMultiBlock(vtkPartitionedDataSetCollection* input, vtkMultiBlockDataSet* output);
+
+#ifndef __VTK_WRAP__
+  /// A complex built in C++; used instead of FileName when set.
+  void SetComplex(std::shared_ptr<const ictk::complex::Complex> complex);
+  /// The VTK form of a discretised complex.
+  static void Convert(const ictk::complex::Complex& complex, const ictk::complex::ComplexMesh& mesh,
+    vtkPartitionedDataSetCollection* output);
+#endif
+
+protected:
+  ictkComplexSource();
+  ~ictkComplexSource() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  std::string FileName;
+  double FeatureSize = 0;
+  int NumberOfThreads = 0;
+
+private:
+  ictkComplexSource(const ictkComplexSource&) = delete;
+  void operator=(const ictkComplexSource&) = delete;
+
+  std::shared_ptr<const ictk::complex::Complex> Complex;
+};
