@@ -40,7 +40,17 @@ AttachResult attachCell(Complex& complex, Cell cell, const AttachOptions& option
       result.boundaryPairs.emplace_back(result.id, id);
       onBoundary = true;
     }
-    if (c.isImplicit() && c.dimension >= g.dimension &&
+    // Beyond seed 001 (which attaches in increasing dimension only): a new cell on the
+    // boundary of an existing higher-dimensional cell is recorded too, so the order of
+    // attachment does not change the complex.
+    bool onItsBoundary = false;
+    if (c.dimension > g.dimension && boundaryHolds(cLocator, gLocator, tol, options.samplesPerCell))
+    {
+      complex.addBoundary(id, result.id);
+      result.boundaryPairs.emplace_back(id, result.id);
+      onItsBoundary = true;
+    }
+    if (!onItsBoundary && c.isImplicit() && c.dimension >= g.dimension &&
       containmentHolds(cLocator, gLocator, tol, options.samplesPerCell))
     {
       complex.addContainment(id, result.id);

@@ -30,7 +30,9 @@ struct AttachResult
 /// dimension on the boundary of the new cell g adds (g, c) to Rb; (2) for every implicit cell c
 /// of dimension >= dim g that contains g adds (c, g) to Rc; (3) when g is implicit, for every
 /// cell c of dimension <= dim g inside g adds (g, c) to Rc. A pair found by (1) is never also
-/// added by (3). Explicit cells contain nothing.
+/// added by (3). Explicit cells contain nothing. Beyond the seed, which attaches cells in
+/// increasing dimension, (c, g) is added to Rb when g lies on the boundary of an existing
+/// higher-dimensional cell c, so the order of attachment does not matter.
 AttachResult attachCell(Complex& complex, Cell cell, const AttachOptions& options = {});
 
 /// Complex attachment (seed 001 L126-128): K_i = K_{i-1} u L / ~psi. `psi` maps cells of the

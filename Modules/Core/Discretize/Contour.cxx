@@ -102,8 +102,6 @@ struct BlockResult
 {
   // Each triangle vertex is an edge key; positions are found after the merge.
   std::vector<std::array<std::uint64_t, 3>> triangles;
-  /// Per triangle: whether the lower corner of its first vertex's edge is inside.
-  std::vector<char> lowerInside;
 };
 
 } // namespace
@@ -255,23 +253,41 @@ SurfaceMesh contourSurface(const frep::Field& field, const Box3& box, const Cont
             {
               continue;
             }
-            // Triangles are oriented after the merge, from the side of the first vertex's edge
-            // that is inside.
-            auto emit = [&](int a, int b, std::uint64_t k1, std::uint64_t k2)
+            // Orient each triangle so that its normal points from inside to outside, computed
+            // on the midpoints of its edges: those never degenerate, unlike the final vertices,
+            // which may coincide when a corner value is zero.
+            auto emit = [&](int a, int b, int c1, int c2, int d1, int d2)
             {
-              out.triangles.push_back({ key(a, b), k1, k2 });
-              out.lowerInside.push_back(v[std::min(a, b)] >= 0 ? 1 : 0);
+              auto mid = [](int p, int q)
+              {
+                return Point3{ 0.5 * ((p & 1) + (q & 1)), 0.5 * (((p >> 1) & 1) + ((q >> 1) & 1)),
+                  0.5 * ((p >> 2) + (q >> 2)) };
+              };
+              const Point3 m0 = mid(a, b), m1 = mid(c1, c2), m2 = mid(d1, d2);
+              const Point3 normal = cross(sub(m1, m0), sub(m2, m0));
+              const int inCorner = v[a] >= 0 ? a : b, outCorner = v[a] >= 0 ? b : a;
+              const Point3 outward{ double((outCorner & 1) - (inCorner & 1)),
+                double(((outCorner >> 1) & 1) - ((inCorner >> 1) & 1)),
+                double((outCorner >> 2) - (inCorner >> 2)) };
+              if (dot(normal, outward) >= 0)
+              {
+                out.triangles.push_back({ key(a, b), key(c1, c2), key(d1, d2) });
+              }
+              else
+              {
+                out.triangles.push_back({ key(a, b), key(d1, d2), key(c1, c2) });
+              }
             };
             if (nin == 1 || nout == 1)
             {
               const int apex = nin == 1 ? in[0] : out4[0];
               const int* others = nin == 1 ? out4 : in;
-              emit(apex, others[0], key(apex, others[1]), key(apex, others[2]));
+              emit(apex, others[0], apex, others[1], apex, others[2]);
             }
             else
             {
-              emit(in[0], out4[0], key(in[0], out4[1]), key(in[1], out4[1]));
-              emit(in[0], out4[0], key(in[1], out4[1]), key(in[1], out4[0]));
+              emit(in[0], out4[0], in[0], out4[1], in[1], out4[1]);
+              emit(in[0], out4[0], in[1], out4[1], in[1], out4[0]);
             }
           }
         }
@@ -394,22 +410,9 @@ SurfaceMesh contourSurface(const frep::Field& field, const Box3& box, const Cont
   };
   for (const auto& r : results)
   {
-    for (std::size_t ti = 0; ti < r.triangles.size(); ++ti)
+    for (const auto& t : r.triangles)
     {
-      const auto& t = r.triangles[ti];
-      // The first key's edge goes from a lower to a higher corner; orient the triangle so its
-      // normal points from the inside corner of that edge to the outside one.
-      const std::uint64_t k0 = t[0];
-      const Point3 a = corner(k0 / 8, 0);
-      const Point3 b = corner(k0 / 8, static_cast<int>(k0 % 8));
-      std::array<std::uint32_t, 3> tri = { indexOf(t[0]), indexOf(t[1]), indexOf(t[2]) };
-      const Point3 normal = cross(sub(mesh.points[tri[1]], mesh.points[tri[0]]),
-        sub(mesh.points[tri[2]], mesh.points[tri[0]]));
-      const Point3 outward = r.lowerInside[ti] ? sub(b, a) : sub(a, b);
-      if (dot(normal, outward) < 0)
-      {
-        std::swap(tri[1], tri[2]);
-      }
+      const std::array<std::uint32_t, 3> tri = { indexOf(t[0]), indexOf(t[1]), indexOf(t[2]) };
       mesh.triangles.push_back(tri);
     }
   }
