@@ -284,6 +284,59 @@ def check_model_files(ictk, work):
     no_leftovers(work)
 
 
+def check_complex_flower(ictk, work, data):
+    """The seed 001 flower: info, validate and mesh into .vtpc and .vtm, read back by VTK."""
+    model = os.path.join(data, "Models", "flower", "flower.json")
+    info = json.loads(run(ictk, ["info", model, "--json"]).stdout)
+    if info["cells_per_dimension"] != [4, 3, 2, 3]:
+        sys.exit(f"FAIL: cells per dimension {info['cells_per_dimension']}")
+    if len(info["relations"]["boundary"]) != 17 or info["relations"]["containment"]:
+        sys.exit(f"FAIL: relations {info['relations']}")
+    report = json.loads(run(ictk, ["validate", model, "--json", "--feature-size", "0.03"]).stdout)
+    if not report["ok"] or report["violated"] or len(report["satisfied"]) != 17:
+        sys.exit(f"FAIL: validation {report}")
+    vtpc = os.path.join(work, "flower.vtpc")
+    run(ictk, ["mesh", model, "-o", vtpc, "--feature-size", "0.03"])
+    import vtk
+    r = vtk.vtkXMLPartitionedDataSetCollectionReader()
+    r.SetFileName(vtpc)
+    r.Update()
+    pdc = r.GetOutput()
+    if pdc.GetNumberOfPartitionedDataSets() != 12:
+        sys.exit(f"FAIL: {pdc.GetNumberOfPartitionedDataSets()} partitioned datasets, not 12")
+    names = set()
+    for i in range(12):
+        leaf = pdc.GetPartitionedDataSet(i).GetPartition(0)
+        names.add(leaf.GetFieldData().GetAbstractArray("CellName").GetValue(0))
+        if leaf.GetNumberOfPoints() == 0 or not leaf.GetPointData().GetArray("colour"):
+            sys.exit(f"FAIL: partition {i} is empty or has no colour")
+    if "t_1^2" not in names:
+        sys.exit(f"FAIL: cell names {names}")
+    assembly = pdc.GetDataAssembly()
+    boundary = assembly.GetFirstNodeByPath("/flower/relations/boundary")
+    if boundary < 0 or assembly.GetNumberOfChildren(boundary) != 8:
+        sys.exit("FAIL: the assembly lacks /flower/relations/boundary with the 8 cells that have a boundary")
+    vtm = os.path.join(work, "flower.vtm")
+    run(ictk, ["mesh", model, "-o", vtm, "--feature-size", "0.03"])
+    m = vtk.vtkXMLMultiBlockDataReader()
+    m.SetFileName(vtm)
+    m.Update()
+    blocks = m.GetOutput()
+    counts = [blocks.GetBlock(p).GetNumberOfBlocks() for p in range(4)]
+    if counts != [4, 3, 2, 3]:
+        sys.exit(f"FAIL: .vtm blocks per dimension {counts}")
+    # A bad relation: exit 2, a diagnostic with file, line and column, nothing written.
+    bad = os.path.join(work, "bad.json")
+    with open(bad, "w") as f:
+        f.write('{"cells": [{"name": "p", "kind": "P", "dimension": 0, "points": [[0, 0, 0]]}],\n'
+                ' "relations": {"boundary": [["p", "q"]]}}\n')
+    p = run(ictk, ["mesh", bad, "-o", os.path.join(work, "bad.vtpc")], check=False)
+    if p.returncode != 2 or not re.search(r"bad\.json:2:\d+: error: .*no cell named 'q'", p.stderr):
+        sys.exit(f"FAIL: bad relation: exit {p.returncode}, stderr {p.stderr!r}")
+    if os.path.exists(os.path.join(work, "bad.vtpc")):
+        sys.exit("FAIL: an output was written for a bad complex")
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -302,6 +355,10 @@ def main():
         "mesh-formats": check_mesh_formats,
         "model-files": check_model_files,
     }
+    if check == "complex-flower":
+        check_complex_flower(ictk, work, rest[0])
+        print("OK")
+        return
     if check == "expect-error":
         if len(rest) < 2 or rest[1] != "--":
             sys.exit("usage: expect-error REGEX -- ICTK-ARGS...")
