@@ -10,7 +10,9 @@
 //   ictkBenchFRep --benchmark_filter=csg3   (any Google Benchmark flag)
 #include "FRep/BundledModels.h"
 #include "FRep/ModelRegistry.h"
+#include "FRep/Render.h"
 #include "FRep/Sampling.h"
+#include "Lang/VmReader.h"
 
 #include <benchmark/benchmark.h>
 #include <tbb/info.h>
@@ -31,7 +33,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <sstream>
 #include <string>
@@ -223,6 +227,49 @@ bool verify(const std::string& model, std::int64_t n)
   return ok;
 }
 
+// The workloads of `ictk bench` (issue 7), for profiling: prospero.vm rendered at 1024^2 by brute
+// force (1 thread) and by interval pruning (2 threads), when Fidget's models are found
+// ($ICTK_BENCH_MODELS, else ICTK_BENCH_MODELS_DIR); csg3 sampled at 512^3 (ICTK only).
+void registerPerformanceWorkloads(bool quick)
+{
+  const char* env = std::getenv("ICTK_BENCH_MODELS");
+  const std::filesystem::path file =
+    std::filesystem::path(env ? env : ICTK_BENCH_MODELS_DIR) / "prospero.vm";
+  if (std::filesystem::exists(file))
+  {
+    const TapePtr tape = Tape::compile(ictk::lang::readVmFile(file.string()).function);
+    for (const bool prune : { false, true })
+    {
+      const std::string name =
+        std::string("ictk/prospero-") + (prune ? "pruned" : "brute") + "/1024";
+      benchmark::RegisterBenchmark(name.c_str(),
+        [tape, prune](benchmark::State& state)
+        {
+          RenderOptions options;
+          options.prune = prune;
+          options.threads = prune ? 2 : 1;
+          for (auto _ : state)
+          {
+            benchmark::DoNotOptimize(renderSign2D(tape, RenderRegion{}, 1024, 1024, options));
+          }
+        })
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
+    }
+  }
+  else
+  {
+    std::printf("%s not found: the prospero workloads are skipped\n", file.string().c_str());
+  }
+  if (!quick)
+  {
+    benchmark::RegisterBenchmark(
+      "ictk/csg3/512", [](benchmark::State& s) { benchIctk(s, "csg3", 512); })
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond);
+  }
+}
+
 /// Passes everything to the console and keeps the real time of each case for the final table.
 class TableReporter : public benchmark::ConsoleReporter
 {
@@ -384,6 +431,8 @@ int main(int argc, char** argv)
       }
     }
   }
+
+  registerPerformanceWorkloads(quick);
 
   TableReporter reporter(colour);
   benchmark::RunSpecifiedBenchmarks(&reporter);

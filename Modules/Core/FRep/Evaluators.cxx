@@ -2,9 +2,11 @@
 #include "FRep/Evaluators.h"
 
 #include "FRep/Kernels.h"
+#include "FRep/TapeDetail.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -82,10 +84,67 @@ namespace
 // allocator never gives an instruction its own input slot), so the compiler vectorises them.
 template <typename T>
 __attribute__((always_inline)) inline void runChunkImpl(
-  const std::vector<Instruction>& code, T* const* slot, std::size_t n)
+  const std::vector<Instruction>& code, T* const* slot, const T* scalars, std::size_t n)
 {
+  constexpr std::uint32_t scalarBit = RowProgram::ScalarOperand;
   for (const Instruction& ins : code)
   {
+    // Row programs: one operand of add, sub, mul, div, min, max may be a uniform scalar.
+    if ((ins.a | ins.b) & scalarBit)
+    {
+      T* __restrict o = slot[ins.out];
+      const bool first = ins.a & scalarBit;
+      const T s = scalars[(first ? ins.a : ins.b) & ~scalarBit];
+      const T* __restrict v = slot[first ? ins.b : ins.a];
+#define ICTK_SCALAR_LOOP(expr)                                                                     \
+  for (std::size_t i = 0; i < n; ++i)                                                              \
+  {                                                                                                \
+    o[i] = (expr);                                                                                 \
+  }                                                                                                \
+  break
+      if (first)
+      {
+        switch (ins.op)
+        {
+          case Opcode::Add:
+            ICTK_SCALAR_LOOP(s + v[i]);
+          case Opcode::Sub:
+            ICTK_SCALAR_LOOP(s - v[i]);
+          case Opcode::Mul:
+            ICTK_SCALAR_LOOP(s * v[i]);
+          case Opcode::Div:
+            ICTK_SCALAR_LOOP(s / v[i]);
+          case Opcode::Min:
+            ICTK_SCALAR_LOOP(detail::minOp(s, v[i]));
+          case Opcode::Max:
+            ICTK_SCALAR_LOOP(detail::maxOp(s, v[i]));
+          default:
+            ICTK_SCALAR_LOOP(applyScalar<T>(ins.op, s, v[i], T(0)));
+        }
+      }
+      else
+      {
+        switch (ins.op)
+        {
+          case Opcode::Add:
+            ICTK_SCALAR_LOOP(v[i] + s);
+          case Opcode::Sub:
+            ICTK_SCALAR_LOOP(v[i] - s);
+          case Opcode::Mul:
+            ICTK_SCALAR_LOOP(v[i] * s);
+          case Opcode::Div:
+            ICTK_SCALAR_LOOP(v[i] / s);
+          case Opcode::Min:
+            ICTK_SCALAR_LOOP(detail::minOp(v[i], s));
+          case Opcode::Max:
+            ICTK_SCALAR_LOOP(detail::maxOp(v[i], s));
+          default:
+            ICTK_SCALAR_LOOP(applyScalar<T>(ins.op, v[i], s, T(0)));
+        }
+      }
+#undef ICTK_SCALAR_LOOP
+      continue;
+    }
     T* __restrict o = slot[ins.out];
     const T* __restrict a = slot[ins.a];
     const T* __restrict b = slot[ins.b];
@@ -137,24 +196,25 @@ __attribute__((always_inline)) inline void runChunkImpl(
 #endif
 
 ICTK_TARGET_CLONES void runChunkFloat(
-  const std::vector<Instruction>& code, float* const* slot, std::size_t n)
+  const std::vector<Instruction>& code, float* const* slot, const float* scalars, std::size_t n)
 {
-  runChunkImpl<float>(code, slot, n);
+  runChunkImpl<float>(code, slot, scalars, n);
 }
 
 ICTK_TARGET_CLONES void runChunkDouble(
-  const std::vector<Instruction>& code, double* const* slot, std::size_t n)
+  const std::vector<Instruction>& code, double* const* slot, const double* scalars, std::size_t n)
 {
-  runChunkImpl<double>(code, slot, n);
+  runChunkImpl<double>(code, slot, scalars, n);
 }
 
 template <typename T>
-void runChunk(const std::vector<Instruction>& code, T* const* slot, std::size_t n)
+void runChunk(
+  const std::vector<Instruction>& code, T* const* slot, std::size_t n, const T* scalars = nullptr)
 {
   if constexpr (std::is_same_v<T, float>)
-    runChunkFloat(code, slot, n);
+    runChunkFloat(code, slot, scalars, n);
   else
-    runChunkDouble(code, slot, n);
+    runChunkDouble(code, slot, scalars, n);
 }
 } // namespace
 
@@ -314,7 +374,7 @@ void BatchEvaluator<T>::evalRowX(double x0, double dx, std::int64_t first, doubl
       }
       rowX_ = key;
     }
-    runChunk<T>(row_.varying, rowSlots_.data(), m);
+    runChunk<T>(row_.varying, rowSlots_.data(), m, s);
     for (std::size_t k = 0; k < outputCount; ++k)
     {
       if (row_.outputs[k].varying)
@@ -334,11 +394,32 @@ namespace
 constexpr double inf = std::numeric_limits<double>::infinity();
 constexpr double pi = 3.14159265358979323846;
 
+// std::nextafter(x, +inf) and (x, -inf), inline (interval evaluation calls them for almost every
+// instruction): step the bit pattern by one, zeros go to the smallest subnormal, infinities and
+// NaN stay.
+inline double nextUp(double x)
+{
+  if (!(x < inf))
+    return x;
+  if (x == 0)
+    return std::numeric_limits<double>::denorm_min();
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits = x > 0 ? bits + 1 : bits - 1;
+  std::memcpy(&x, &bits, sizeof bits);
+  return x;
+}
+
+inline double nextDown(double x)
+{
+  return -nextUp(-x);
+}
+
 // Outward rounding by one ulp each side: the libm functions used are faithful to within an ulp,
 // so the widened interval encloses every value the point evaluators can produce.
 Interval widen(Interval r)
 {
-  return { std::nextafter(r.lo, -inf), std::nextafter(r.hi, inf), r.maybeNaN };
+  return { nextDown(r.lo), nextUp(r.hi), r.maybeNaN };
 }
 
 // Widening must not push a bound below zero when the result cannot be negative (a square, a sum
@@ -490,7 +571,7 @@ Interval intervalOp(
     default:
       break;
   }
-  const int arity = opcodeArity(op);
+  const int arity = detail::arity(op);
   if (a.empty() || (arity > 1 && b.empty()))
   {
     return nowhere();

@@ -33,8 +33,9 @@ struct RenderOptions
   /// Tile edges, coarse to fine, each a multiple of the next: tiles of tileSizes[0] are bounded
   /// with the full tape, then split into tiles of tileSizes[1] bounded with the pruned tape, and so
   /// on; the pixels of the last level's undecided tiles are evaluated. Along z (3D) the same edges
-  /// are used.
-  std::vector<int> tileSizes{ 64, 8 };
+  /// are used. The default was the fastest on prospero.vm at 1024^2 (docs/performance.md): below
+  /// 32 pixels, pruning costs more than the instructions it removes.
+  std::vector<int> tileSizes{ 128, 32 };
   /// Evaluate pixels in float (true) or double. Interval decisions are made in double either
   /// way: in double the pruned image equals the brute-force one exactly; in float they agree
   /// except where a pixel's value is within float rounding of 0 or of a pruned min/max tie.

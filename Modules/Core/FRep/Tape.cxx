@@ -24,11 +24,17 @@ std::uint32_t allocateRegisters(const std::vector<SsaOp>& ssa, std::uint32_t fir
   // Value ids are dense (below slotOfValue.size()), so a vector is enough: this runs for every
   // pruned tape, so it must be cheap.
   std::vector<std::size_t> lastUse(slotOfValue.size(), unused);
+  // Operands flagged RowProgram::ScalarOperand are not values of this allocation: they pass
+  // through unchanged.
+  constexpr std::uint32_t scalar = RowProgram::ScalarOperand;
   for (std::size_t i = 0; i < ssa.size(); ++i)
   {
-    for (int k = 0; k < opcodeArity(ssa[i].op); ++k)
+    for (int k = 0; k < detail::arity(ssa[i].op); ++k)
     {
-      lastUse.at(ssa[i].operand[k]) = i;
+      if (!(ssa[i].operand[k] & scalar))
+      {
+        lastUse.at(ssa[i].operand[k]) = i;
+      }
     }
   }
   for (std::uint32_t v : pinned)
@@ -54,16 +60,20 @@ std::uint32_t allocateRegisters(const std::vector<SsaOp>& ssa, std::uint32_t fir
     }
     Instruction ins{ op.op, out, 0, 0, 0 };
     std::uint32_t* operands[3] = { &ins.a, &ins.b, &ins.c };
-    const int arity = opcodeArity(op.op);
+    const int arity = detail::arity(op.op);
     for (int k = 0; k < arity; ++k)
     {
-      *operands[k] = slotOfValue.at(op.operand[k]);
+      *operands[k] = (op.operand[k] & scalar) ? op.operand[k] : slotOfValue.at(op.operand[k]);
     }
     // Inputs are released after the output is allocated, so an instruction never writes the slot
     // it reads: batch kernels may then treat their pointers as non-aliasing.
     for (int k = 0; k < arity; ++k)
     {
       const std::uint32_t v = op.operand[k];
+      if (v & scalar)
+      {
+        continue;
+      }
       bool repeated = false;
       for (int j = 0; j < k; ++j)
       {
@@ -189,7 +199,7 @@ TapePtr Tape::build(std::uint32_t parameterCount, std::vector<double> constants,
     {
       ++tape->choiceCount_;
     }
-    for (int k = 0; k < opcodeArity(s.op); ++k)
+    for (int k = 0; k < detail::arity(s.op); ++k)
     {
       axes[result] |= axes[ops.back().operand[k]];
     }
@@ -267,7 +277,7 @@ TapePtr Tape::simplify(const std::vector<Choice>& choices) const
     }
     const TapeSsa& s = ssa_[i];
     const std::uint32_t operands[3] = { s.a, s.b, s.c };
-    for (int k = 0; k < opcodeArity(s.op); ++k)
+    for (int k = 0; k < detail::arity(s.op); ++k)
     {
       live[alias[operands[k]]] = true;
     }
@@ -296,9 +306,9 @@ TapePtr Tape::simplify(const std::vector<Choice>& choices) const
     }
     TapeSsa s = ssa_[i];
     s.a = renumber[alias[s.a]];
-    if (opcodeArity(s.op) > 1)
+    if (detail::arity(s.op) > 1)
       s.b = renumber[alias[s.b]];
-    if (opcodeArity(s.op) > 2)
+    if (detail::arity(s.op) > 2)
       s.c = renumber[alias[s.c]];
     renumber[v] = static_cast<std::uint32_t>(newLeafCount + kept.size());
     kept.push_back(s);
@@ -334,7 +344,18 @@ RowProgram Tape::rowProgram(std::uint8_t varyingAxes) const
     }
     else
     {
-      varyingOps.push_back({ s.op, v, { s.a, s.b, s.c } });
+      SsaOp op{ s.op, v, { s.a, s.b, s.c } };
+      // One uniform operand of a simple binary operation is read as a scalar.
+      const bool scalarForm = s.op == Opcode::Add || s.op == Opcode::Sub || s.op == Opcode::Mul ||
+        s.op == Opcode::Div || s.op == Opcode::Min || s.op == Opcode::Max;
+      for (int k = 0; scalarForm && k < 2; ++k)
+      {
+        if (!varies(op.operand[k]))
+        {
+          op.operand[k] |= RowProgram::ScalarOperand;
+        }
+      }
+      varyingOps.push_back(op);
     }
   }
 
@@ -352,9 +373,13 @@ RowProgram Tape::rowProgram(std::uint8_t varyingAxes) const
   }
   for (const SsaOp& op : varyingOps)
   {
-    for (int k = 0; k < opcodeArity(op.op); ++k)
+    for (int k = 0; k < detail::arity(op.op); ++k)
     {
       const std::uint32_t v = op.operand[k];
+      if (v & RowProgram::ScalarOperand)
+      {
+        continue;
+      }
       if (!varies(v) && slotOfValue[v] == std::numeric_limits<std::uint32_t>::max())
       {
         slotOfValue[v] = next;

@@ -40,7 +40,10 @@ struct RowProgram
   std::vector<std::pair<std::uint32_t, std::uint32_t>> broadcasts;
   /// The same for values that depend on no coordinate (constants, parameters): copied once.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> fixedBroadcasts;
-  /// Per-point code over chunk slots.
+  /// Per-point code over chunk slots. An operand with the ScalarOperand bit set is a uniform value
+  /// read from the scalar slots (value id = operand without the bit): add, sub, mul, div, min and
+  /// max take one operand that way instead of a broadcast chunk, which saves the memory traffic.
+  static constexpr std::uint32_t ScalarOperand = 0x80000000u;
   std::vector<Instruction> varying;
   std::uint32_t chunkSlotCount = 0;
   /// Chunk slot of each varying axis.

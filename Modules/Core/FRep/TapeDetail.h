@@ -7,6 +7,16 @@
 namespace ictk::frep::detail
 {
 
+/// opcodeArity, inline (the enumeration is ordered: leaves, unary, binary, select).
+inline int arity(Opcode op)
+{
+  if (op >= Opcode::Add)
+  {
+    return op == Opcode::Select ? 3 : 2;
+  }
+  return op >= Opcode::Neg ? 1 : 0;
+}
+
 struct SsaOp
 {
   Opcode op;

@@ -1,0 +1,519 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// `ictk bench`: the workloads of issue 7, each run several times in this process (median
+// reported). Where VTK can express the model, the VTK equivalent is timed in the same process and
+// the two fields are first checked to describe the same shape.
+//
+//   prospero-brute-1024   sign of prospero.vm on 1024^2 pixels of [-1,1]^2, every pixel evaluated
+//                         with the full tape, 1 thread (libfive: 711 ms)
+//   prospero-pruned-1024  the same image by recursive interval subdivision, 2 threads (libfive:
+//                         132 ms)
+//   csg3-512              frep::sampleGrid of the bundled csg3 at 512^3 (float) against
+//                         vtkSampleFunction on the equivalent vtkImplicitBoolean
+#include "Bench.h"
+
+#include "FRep/BundledModels.h"
+#include "FRep/ModelRegistry.h"
+#include "FRep/Render.h"
+#include "FRep/Sampling.h"
+#include "Lang/VmReader.h"
+
+#include <vtkBox.h>
+#include <vtkCylinder.h>
+#include <vtkImageData.h>
+#include <vtkImplicitBoolean.h>
+#include <vtkImplicitFunction.h>
+#include <vtkSMPTools.h>
+#include <vtkSampleFunction.h>
+#include <vtkSmartPointer.h>
+#include <vtkSphere.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace ictk::app
+{
+
+namespace
+{
+namespace frep = ictk::frep;
+namespace bundled = ictk::frep::bundled;
+using bundled::CsgNode;
+
+#ifndef ICTK_DEFAULT_BENCH_MODELS
+#define ICTK_DEFAULT_BENCH_MODELS ""
+#endif
+
+struct BenchOptions
+{
+  bool Json = false;
+  std::string Models;
+  int Threads = 0; // 0: each workload's own default
+  int Runs = 5;
+  std::string Only;
+  bool Quick = false;
+};
+
+BenchOptions Options;
+
+struct Result
+{
+  std::string workload;
+  std::string what;
+  double seconds = 0;
+  std::vector<double> allSeconds;
+  std::vector<double> cpuSeconds;
+  int threads = 1;
+  double work = 0; // pixels or points
+  std::string unit;
+  std::optional<double> vtkSeconds;
+  std::optional<double> referenceSeconds; // published figure of another tool
+  std::string reference;
+  std::optional<double> goalSeconds;
+  std::optional<double> goalRatio; // vtk_seconds / seconds to reach
+  nlohmann::json details = nlohmann::json::object();
+};
+
+double Median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double ProcessCpuSeconds()
+{
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// One untimed warm-up run, then `runs` timed ones (wall-clock seconds). `cpu`, when given,
+/// receives the process CPU seconds of each run: on a shared machine, CPU time / threads is what
+/// the run would take with the cores to itself.
+std::vector<double> Time(
+  int runs, const std::function<void()>& f, std::vector<double>* cpu = nullptr)
+{
+  f();
+  std::vector<double> seconds;
+  for (int i = 0; i < runs; ++i)
+  {
+    const double c0 = ProcessCpuSeconds();
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    const auto t1 = std::chrono::steady_clock::now();
+    const double c1 = ProcessCpuSeconds();
+    seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+    if (cpu)
+    {
+      cpu->push_back(c1 - c0);
+    }
+  }
+  return seconds;
+}
+
+int ThreadsOr(int fallback)
+{
+  return Options.Threads > 0 ? Options.Threads : fallback;
+}
+
+std::string ModelsFolder()
+{
+  if (!Options.Models.empty())
+  {
+    return Options.Models;
+  }
+  if (const char* env = std::getenv("ICTK_BENCH_MODELS"))
+  {
+    return env;
+  }
+  return ICTK_DEFAULT_BENCH_MODELS;
+}
+
+// --- prospero -----------------------------------------------------------------------------------
+
+frep::TapePtr ProsperoTape(std::string& whyNot)
+{
+  const std::filesystem::path file = std::filesystem::path(ModelsFolder()) / "prospero.vm";
+  if (ModelsFolder().empty() || !std::filesystem::exists(file))
+  {
+    whyNot = "'" + file.string() + "' not found (give the folder of Fidget's models with --models)";
+    return nullptr;
+  }
+  return frep::Tape::compile(lang::readVmFile(file.string()).function);
+}
+
+Result Prospero(const frep::TapePtr& tape, bool prune, int size)
+{
+  Result r;
+  r.workload = std::string("prospero-") + (prune ? "pruned-" : "brute-") + std::to_string(size);
+  r.what = prune ? "sign of prospero.vm, recursive interval subdivision (tiles 128, 32), float"
+                 : "sign of prospero.vm, every pixel with the full tape, float";
+  r.threads = ThreadsOr(prune ? 2 : 1);
+  r.work = static_cast<double>(size) * size;
+  r.unit = "Mpixel/s";
+  frep::RenderOptions options;
+  options.prune = prune;
+  options.threads = r.threads;
+  std::vector<std::uint8_t> image;
+  r.allSeconds = Time(
+    Options.Runs,
+    [&] { image = frep::renderSign2D(tape, frep::RenderRegion{}, size, size, options); },
+    &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  frep::RenderStats stats;
+  options.stats = &stats;
+  image = frep::renderSign2D(tape, frep::RenderRegion{}, size, size, options);
+  std::int64_t inside = 0;
+  for (std::uint8_t v : image)
+  {
+    inside += v;
+  }
+  r.details["tape_instructions"] = tape->instructions().size();
+  r.details["inside_pixels"] = inside;
+  r.details["pixels_evaluated"] = stats.pixelsEvaluated;
+  if (prune)
+  {
+    r.details["tiles_filled"] = stats.tilesFilled;
+    r.details["leaf_tiles_evaluated"] = stats.tilesEvaluated;
+    r.details["mean_leaf_tape_instructions"] = stats.tilesEvaluated
+      ? static_cast<double>(stats.leafInstructions) / static_cast<double>(stats.tilesEvaluated)
+      : 0.0;
+  }
+  if (size == 1024)
+  {
+    r.reference = prune ? "libfive 132 ms" : "libfive 711 ms";
+    r.referenceSeconds = prune ? 0.132 : 0.711;
+    r.goalSeconds = prune ? 0.033 : 0.178;
+  }
+  return r;
+}
+
+// --- csg3 against VTK ---------------------------------------------------------------------------
+
+vtkSmartPointer<vtkImplicitFunction> ToVtk(const bundled::CsgRecipe& r, int index)
+{
+  const CsgNode& n = r.nodes.at(static_cast<std::size_t>(index));
+  switch (n.kind)
+  {
+    case CsgNode::Kind::Sphere:
+    {
+      auto s = vtkSmartPointer<vtkSphere>::New();
+      s->SetCenter(n.p[0], n.p[1], n.p[2]);
+      s->SetRadius(n.p[3]);
+      return s;
+    }
+    case CsgNode::Kind::Box:
+    {
+      auto b = vtkSmartPointer<vtkBox>::New();
+      b->SetBounds(n.p[0], n.p[3], n.p[1], n.p[4], n.p[2], n.p[5]);
+      return b;
+    }
+    case CsgNode::Kind::CylinderY:
+    {
+      auto c = vtkSmartPointer<vtkCylinder>::New();
+      c->SetCenter(n.p[0], n.p[1], n.p[2]);
+      c->SetRadius(n.p[3]);
+      c->SetAxis(0, 1, 0);
+      return c;
+    }
+    case CsgNode::Kind::Union:
+    case CsgNode::Kind::Intersection:
+    case CsgNode::Kind::Difference:
+    {
+      auto op = vtkSmartPointer<vtkImplicitBoolean>::New();
+      if (n.kind == CsgNode::Kind::Union)
+      {
+        op->SetOperationTypeToUnion();
+      }
+      else if (n.kind == CsgNode::Kind::Intersection)
+      {
+        op->SetOperationTypeToIntersection();
+      }
+      else
+      {
+        op->SetOperationTypeToDifference();
+      }
+      op->AddFunction(ToVtk(r, n.a));
+      op->AddFunction(ToVtk(r, n.b));
+      return op;
+    }
+  }
+  throw std::logic_error("bench: bad CSG node");
+}
+
+Result Csg3(int size)
+{
+  Result r;
+  r.workload = "csg3-" + std::to_string(size);
+  r.what = "dense sampling of csg3 (float): frep::sampleGrid vs vtkSampleFunction on the "
+           "equivalent vtkImplicitBoolean (vtkSphere, vtkBox, vtkCylinder)";
+  r.threads = ThreadsOr(2);
+  r.work = static_cast<double>(size) * size * size;
+  r.unit = "Mpts/s";
+  const frep::ModelInfo& info = frep::findModel("csg3");
+  const frep::TapePtr tape = frep::Tape::compile(info.build().geometry().function());
+  const bundled::CsgRecipe recipe = bundled::csg3Recipe();
+  vtkSmartPointer<vtkImplicitFunction> vtkFunction = ToVtk(recipe, recipe.root);
+
+  // The same shape: ICTK's field is minus VTK's, so the signs must be opposite wherever the
+  // value is not within rounding of zero.
+  {
+    std::mt19937 rng(2024);
+    frep::PointEvaluator point(tape);
+    int agree = 0, compared = 0;
+    const int samples = 4000;
+    for (int i = 0; i < samples; ++i)
+    {
+      double p[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        const double u = static_cast<double>(rng()) / 4294967296.0;
+        p[a] = info.boundsLo[a] + u * (info.boundsHi[a] - info.boundsLo[a]);
+      }
+      const double fi = point.eval(p[0], p[1], p[2]);
+      const double fv = vtkFunction->EvaluateFunction(p);
+      if (std::abs(fi) < 1e-9 || std::abs(fv) < 1e-9)
+      {
+        continue;
+      }
+      ++compared;
+      agree += (fi > 0) == (fv < 0);
+    }
+    r.details["shape_check_points"] = compared;
+    r.details["shape_check_agree"] = agree;
+    if (agree != compared || compared < samples / 2)
+    {
+      throw std::runtime_error("bench: csg3 and its VTK equivalent disagree at " +
+        std::to_string(compared - agree) + " of " + std::to_string(compared) + " points");
+    }
+  }
+
+  const frep::Grid grid = frep::gridOverBox(info.boundsLo, info.boundsHi, { size, size, size });
+  std::vector<float> out(static_cast<std::size_t>(grid.pointCount()));
+  frep::SampleOptions options;
+  options.threads = r.threads;
+  r.allSeconds = Time(
+    Options.Runs, [&] { frep::sampleGrid(tape, grid, out.data(), options); }, &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  out = {};
+
+  vtkSMPTools::Initialize(r.threads);
+  auto sample = vtkSmartPointer<vtkSampleFunction>::New();
+  sample->SetImplicitFunction(vtkFunction);
+  sample->SetModelBounds(info.boundsLo[0], info.boundsHi[0], info.boundsLo[1], info.boundsHi[1],
+    info.boundsLo[2], info.boundsHi[2]);
+  sample->SetSampleDimensions(size, size, size);
+  sample->SetOutputScalarTypeToFloat();
+  sample->ComputeNormalsOff();
+  sample->CappingOff();
+  // VTK is slow: at most 3 timed runs.
+  std::vector<double> vtkCpu;
+  const std::vector<double> vtkRuns = Time(
+    std::min(Options.Runs, 3),
+    [&]
+    {
+      sample->Modified();
+      sample->Update();
+    },
+    &vtkCpu);
+  r.vtkSeconds = Median(vtkRuns);
+  r.details["vtk_cpu_seconds"] = Median(vtkCpu);
+  r.details["vtk_all_seconds"] = vtkRuns;
+  r.details["vtk_smp_backend"] = vtkSMPTools::GetBackend();
+  r.goalRatio = 5.0;
+  return r;
+}
+
+// --- output -------------------------------------------------------------------------------------
+
+nlohmann::json ToJson(const Result& r)
+{
+  nlohmann::json j;
+  j["workload"] = r.workload;
+  j["description"] = r.what;
+  j["seconds"] = r.seconds;
+  j["all_seconds"] = r.allSeconds;
+  j["runs"] = r.allSeconds.size();
+  if (!r.cpuSeconds.empty())
+  {
+    j["cpu_seconds"] = Median(r.cpuSeconds);
+  }
+  j["threads"] = r.threads;
+  j["throughput"] = r.work / r.seconds * 1e-6;
+  j["throughput_unit"] = r.unit;
+  if (r.vtkSeconds)
+  {
+    j["vtk_seconds"] = *r.vtkSeconds;
+    j["ratio_vs_vtk"] = *r.vtkSeconds / r.seconds; // > 1: ICTK is faster
+  }
+  if (r.referenceSeconds)
+  {
+    j["reference"] = r.reference;
+    j["reference_seconds"] = *r.referenceSeconds;
+  }
+  if (r.goalSeconds)
+  {
+    j["goal_seconds"] = *r.goalSeconds;
+    j["goal_met"] = r.seconds <= *r.goalSeconds;
+  }
+  if (r.goalRatio && r.vtkSeconds)
+  {
+    j["goal_ratio_vs_vtk"] = *r.goalRatio;
+    j["goal_met"] = *r.vtkSeconds / r.seconds >= *r.goalRatio;
+  }
+  j["details"] = r.details;
+  return j;
+}
+
+void PrintLine(const Result& r)
+{
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(1);
+  os << r.workload << ": " << r.seconds * 1e3 << " ms (median of " << r.allSeconds.size() << "), "
+     << r.work / r.seconds * 1e-6 << " " << r.unit << ", " << r.threads << " thread"
+     << (r.threads == 1 ? "" : "s");
+  if (r.vtkSeconds)
+  {
+    os.precision(2);
+    os << "; VTK " << *r.vtkSeconds * 1e3 << " ms, ICTK " << *r.vtkSeconds / r.seconds
+       << "x faster";
+  }
+  if (r.referenceSeconds)
+  {
+    os.precision(2);
+    os << "; " << r.reference << " (" << *r.referenceSeconds / r.seconds << "x)";
+  }
+  if (r.goalSeconds)
+  {
+    os.precision(1);
+    os << "; goal <= " << *r.goalSeconds * 1e3
+       << " ms: " << (r.seconds <= *r.goalSeconds ? "met" : "missed");
+  }
+  if (r.goalRatio && r.vtkSeconds)
+  {
+    os.precision(1);
+    os << "; goal >= " << *r.goalRatio
+       << "x VTK: " << (*r.vtkSeconds / r.seconds >= *r.goalRatio ? "met" : "missed");
+  }
+  std::cout << os.str() << "\n" << std::flush;
+}
+
+bool Selected(const std::string& name)
+{
+  if (Options.Only.empty())
+  {
+    return true;
+  }
+  std::stringstream list(Options.Only);
+  std::string item;
+  while (std::getline(list, item, ','))
+  {
+    if (!item.empty() && name.find(item) != std::string::npos)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+} // namespace
+
+CLI::App* AddBenchCommand(CLI::App& app)
+{
+  CLI::App* bench = app.add_subcommand("bench",
+    "Time the performance workloads (prospero rendering, csg3 sampling against VTK); see "
+    "docs/performance.md");
+  bench->add_flag("--json", Options.Json, "Print a JSON array, one object per workload");
+  bench->add_option("--models", Options.Models,
+    "Folder of Fidget's .vm models (default: $ICTK_BENCH_MODELS, else the build's default)");
+  bench->add_option("--threads", Options.Threads,
+    "Threads for every workload (default: 1 for brute force, 2 otherwise)");
+  bench->add_option("--runs", Options.Runs, "Timed runs per workload (median reported)")
+    ->check(CLI::Range(1, 1000));
+  bench->add_option(
+    "--only", Options.Only, "Run the workloads whose name contains one of these (comma-separated)");
+  bench->add_flag(
+    "--quick", Options.Quick, "Small sizes (prospero 128^2, csg3 64^3), one run: a smoke test");
+  return bench;
+}
+
+int RunBenchCommand()
+{
+  if (Options.Threads < 0)
+  {
+    throw std::invalid_argument("--threads must be at least 0");
+  }
+  if (Options.Quick)
+  {
+    Options.Runs = 1;
+  }
+  const int renderSize = Options.Quick ? 128 : 1024;
+  const int sampleSize = Options.Quick ? 64 : 512;
+  std::vector<Result> results;
+  auto report = [&](Result r)
+  {
+    if (!Options.Json)
+    {
+      PrintLine(r);
+    }
+    results.push_back(std::move(r));
+  };
+  const std::string brute = "prospero-brute-" + std::to_string(renderSize);
+  const std::string pruned = "prospero-pruned-" + std::to_string(renderSize);
+  if (Selected(brute) || Selected(pruned))
+  {
+    std::string whyNot;
+    const frep::TapePtr tape = ProsperoTape(whyNot);
+    if (!tape)
+    {
+      std::cerr << "ictk bench: skipping the prospero workloads: " << whyNot << "\n";
+    }
+    else
+    {
+      if (Selected(brute))
+      {
+        report(Prospero(tape, false, renderSize));
+      }
+      if (Selected(pruned))
+      {
+        report(Prospero(tape, true, renderSize));
+      }
+    }
+  }
+  if (Selected("csg3-" + std::to_string(sampleSize)))
+  {
+    report(Csg3(sampleSize));
+  }
+  if (results.empty() && !Options.Only.empty())
+  {
+    throw std::invalid_argument("--only '" + Options.Only + "' matches no workload that can run");
+  }
+  if (Options.Json)
+  {
+    nlohmann::json all = nlohmann::json::array();
+    for (const Result& r : results)
+    {
+      all.push_back(ToJson(r));
+    }
+    std::cout << all.dump(2) << "\n";
+  }
+  return 0;
+}
+
+} // namespace ictk::app
