@@ -46,7 +46,7 @@ complex::Complex LoadComplex(const std::string& path)
 {
   if (IsComplexInput(path))
   {
-    return lang::readComplexFile(path);
+    return ictkComplexSource::ReadComplexFile(path);
   }
   if (!lang::isModelFile(path))
   {

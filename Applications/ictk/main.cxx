@@ -17,6 +17,7 @@
 #include "FRep/Sampling.h"
 #include "Lang/ModelFile.h"
 
+#include "Bench.h"
 #include "ictkFRepSampler.h"
 
 #include <vtkCallbackCommand.h>
@@ -1089,6 +1090,8 @@ int Run(int argc, char** argv)
     ->required();
   convert->add_option("output", convertOptions.Output, "The .hf or .xml file to write")->required();
 
+  CLI::App* bench = ictk::app::AddBenchCommand(app);
+
   GridCommandOptions meshOptions;
   double meshFeatureSize = 0;
   CLI::App* mesh = app.add_subcommand("mesh",
@@ -1141,6 +1144,10 @@ int Run(int argc, char** argv)
     throw UserError(std::string(e.what()) + " (see ictk --help)");
   }
 
+  if (*bench)
+  {
+    return ictk::app::RunBenchCommand();
+  }
   if (*models)
   {
     return RunModels(modelsJson);
@@ -1188,6 +1195,11 @@ int main(int argc, char** argv)
   }
   catch (const ModelFileError& e)
   {
+    std::cerr << e.what() << "\n";
+  }
+  catch (const ictk::lang::ParseError& e)
+  {
+    // Diagnostics carry their own "file:line:col: error:" prefix, source line and caret.
     std::cerr << e.what() << "\n";
   }
   catch (const std::bad_alloc&)

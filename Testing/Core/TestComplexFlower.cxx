@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The seed 001 flower (Data/Models/flower) end to end, the complex JSON reader's errors, cell
-// attachment, and the accuracy of the per-dimension discretisers against analytic sets.
+// and complex attachment, and marching tetrahedra against the analytic sphere (the lower-
+// dimensional discretisers are tested in TestDiscretizeCells).
 
 #include "Complex/Attachment.h"
 #include "Complex/Validation.h"
-#include "Discretize/Contour.h"
+#include "Discretize/MarchingTetrahedra.h"
 #include "FRep/Primitives.h"
 #include "FRep/Tape.h"
 #include "Lang/ComplexFile.h"
@@ -235,7 +236,7 @@ TEST(ComplexFile, ErrorsNameFileLineAndCell)
   EXPECT_THROW(lang::readComplexFile("/nonexistent/x.json"), lang::ParseError);
 }
 
-TEST(Discretize, SphereSurfaceWithinTolerance)
+TEST(MarchingTetrahedra, SphereSurfaceWithinTolerance)
 {
   // Marching tetrahedra with vertices refined onto f = 0: vertices within 1e-6 of the sphere;
   // triangle centroids within the chord error h^2 / (8 R) (h the longest edge, here at most
@@ -244,7 +245,7 @@ TEST(Discretize, SphereSurfaceWithinTolerance)
   discretize::ContourOptions o;
   o.featureSize = 0.05;
   const discretize::SurfaceMesh m =
-    discretize::contourSurface(*f, { { -1.2, -1.2, -1.2 }, { 1.2, 1.2, 1.2 } }, o);
+    discretize::marchingTetrahedra(*f, { { -1.2, -1.2, -1.2 }, { 1.2, 1.2, 1.2 } }, o);
   double worstVertex = 0, worstCentroid = 0;
   for (const Point3& p : m.points)
   {
@@ -274,88 +275,12 @@ TEST(Discretize, SphereSurfaceWithinTolerance)
   // Deterministic for any thread count.
   o.threads = 1;
   const discretize::SurfaceMesh one =
-    discretize::contourSurface(*f, { { -1.2, -1.2, -1.2 }, { 1.2, 1.2, 1.2 } }, o);
+    discretize::marchingTetrahedra(*f, { { -1.2, -1.2, -1.2 }, { 1.2, 1.2, 1.2 } }, o);
   EXPECT_EQ(one.points, m.points);
   EXPECT_EQ(one.triangles, m.triangles);
   o.featureSize = 1e-6;
   EXPECT_THROW(
-    discretize::contourSurface(*f, { { -1, -1, -1 }, { 1, 1, 1 } }, o), std::invalid_argument);
-}
-
-TEST(Discretize, IntersectionCircleAndTrimmedCap)
-{
-  // Sphere of radius 1 and plane z = 0.6: the circle of radius 0.8 at z = 0.6. Curve vertices
-  // within 1e-8 of it (Hausdorff from the curve), and the curve passes within the chord error
-  // of every analytic point (Hausdorff to the curve); the cap z >= 0.6 has area 2 pi R h with
-  // h = 0.4, and its boundary vertices lie on the circle.
-  const frep::FieldPtr sphere = field(frep::sphere({ 0, 0, 0 }, 1).function());
-  const frep::FieldPtr plane = field(frep::Expr::z() - 0.6);
-  discretize::ContourOptions o;
-  o.featureSize = 0.04;
-  o.closeAtBox = false;
-  const Box3 box{ { -1.1, -1.1, -1.1 }, { 1.1, 1.1, 1.1 } };
-  const discretize::SurfaceMesh s = discretize::contourSurface(*sphere, box, o);
-  const discretize::CurveSet c = discretize::curvesOnSurface(s, *sphere, *plane, {});
-  ASSERT_EQ(c.lines.size(), 1u);
-  EXPECT_EQ(c.lines[0].front(), c.lines[0].back());
-  double fromCurve = 0;
-  for (const Point3& p : c.points)
-  {
-    fromCurve = std::max(fromCurve, std::abs(std::hypot(p[0], p[1]) - 0.8) + std::abs(p[2] - 0.6));
-  }
-  EXPECT_LT(fromCurve, 1e-8);
-  double toCurve = 0;
-  for (int i = 0; i < 360; ++i)
-  {
-    const Point3 q{ 0.8 * std::cos(i * M_PI / 180), 0.8 * std::sin(i * M_PI / 180), 0.6 };
-    double best = 1e9;
-    const auto& line = c.lines[0];
-    for (std::size_t j = 0; j + 1 < line.size(); ++j)
-    {
-      best = std::min(best, segmentDistance(q, c.points[line[j]], c.points[line[j + 1]]));
-    }
-    toCurve = std::max(toCurve, best);
-  }
-  EXPECT_LT(toCurve, 0.04 * 0.04 / (8 * 0.8) * 4);
-  const discretize::SurfaceMesh cap = discretize::trimSurface(s, *sphere, { plane });
-  EXPECT_NEAR(discretize::surfaceArea(cap), 2 * M_PI * 0.4, 0.01 * 2 * M_PI * 0.4);
-  const discretize::MeshTopology t = discretize::analyzeTopology(cap);
-  EXPECT_EQ(t.eulerCharacteristic, 1); // a disc
-  // Boundary vertices of the cap: on the circle, so the patch edge and the traced curve coincide.
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
-  for (const auto& tri : cap.triangles)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      ++uses[{ std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3]) }];
-    }
-  }
-  int boundaryVertices = 0;
-  for (const auto& [edge, count] : uses)
-  {
-    if (count == 1)
-    {
-      for (auto v : { edge.first, edge.second })
-      {
-        const Point3& p = cap.points[v];
-        EXPECT_LT(std::abs(std::hypot(p[0], p[1]) - 0.8) + std::abs(p[2] - 0.6), 1e-8);
-        ++boundaryVertices;
-      }
-    }
-  }
-  EXPECT_GT(boundaryVertices, 50);
-}
-
-TEST(Discretize, PointsWhereThreeFieldsVanish)
-{
-  // x^2 + y^2 + z^2 = 1, z = 0, y = 0: the points (-1, 0, 0) and (1, 0, 0).
-  const frep::FieldPtr sphere = field(frep::sphere({ 0, 0, 0 }, 1).function());
-  const discretize::PointSet p = discretize::solvePoints(*sphere, *field(frep::Expr::z()),
-    *field(frep::Expr::y()), { { -2, -2, -2 }, { 2, 2, 2 } }, 1e-3);
-  ASSERT_EQ(p.points.size(), 2u);
-  EXPECT_NEAR(p.points[0][0], -1, 1e-9);
-  EXPECT_NEAR(p.points[1][0], 1, 1e-9);
-  EXPECT_NEAR(p.points[1][1], 0, 1e-9);
+    discretize::marchingTetrahedra(*f, { { -1, -1, -1 }, { 1, 1, 1 } }, o), std::invalid_argument);
 }
 
 TEST(Attachment, CellAttachmentDerivesRelations)

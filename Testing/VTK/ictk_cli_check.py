@@ -3,7 +3,7 @@
 """Runs the ictk command-line tool as a user would and checks what it prints and writes.
 
 Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
-  models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d
+  models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d | bench
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
 "@WORK@" in ICTK-ARGS is replaced by the work folder.
 """
@@ -337,6 +337,29 @@ def check_complex_flower(ictk, work, data):
         sys.exit("FAIL: an output was written for a bad complex")
 
 
+def check_bench(ictk, work):
+    # `ictk bench --quick`: small sizes, one run. Only the report's shape is checked, not timings.
+    p = run(ictk, ["bench", "--json", "--quick", "--only", "csg3"])
+    results = json.loads(p.stdout)
+    if not isinstance(results, list) or len(results) != 1:
+        sys.exit(f"FAIL: expected one workload, got {p.stdout}")
+    r = results[0]
+    for key in ("workload", "seconds", "threads", "throughput", "vtk_seconds", "ratio_vs_vtk"):
+        if key not in r:
+            sys.exit(f"FAIL: key {key!r} missing from {r}")
+    if r["workload"] != "csg3-64" or not r["seconds"] > 0 or not r["vtk_seconds"] > 0:
+        sys.exit(f"FAIL: bad values in {r}")
+    near(r["ratio_vs_vtk"], r["vtk_seconds"] / r["seconds"], 1e-9 * r["ratio_vs_vtk"], "ratio_vs_vtk")
+    if r["details"]["shape_check_agree"] != r["details"]["shape_check_points"]:
+        sys.exit(f"FAIL: ICTK and VTK csg3 disagree: {r['details']}")
+    # The plain report names the workload; an --only that matches nothing is a user error.
+    if "csg3-64:" not in run(ictk, ["bench", "--quick", "--only", "csg3"]).stdout:
+        sys.exit("FAIL: plain report")
+    p = run(ictk, ["bench", "--only", "nothing-like-this"], check=False)
+    if p.returncode != 2 or "ictk: error: --only" not in p.stderr:
+        sys.exit(f"FAIL: --only without a match: exit {p.returncode}\n{p.stderr}")
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -354,6 +377,7 @@ def main():
         "sample-disk2d": check_sample_disk2d,
         "mesh-formats": check_mesh_formats,
         "model-files": check_model_files,
+        "bench": check_bench,
     }
     if check == "complex-flower":
         check_complex_flower(ictk, work, rest[0])

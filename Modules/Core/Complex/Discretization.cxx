@@ -2,7 +2,11 @@
 #include "Complex/Discretization.h"
 
 #include "Complex/Attributes.h"
-#include "Discretize/Contour.h"
+#include "Discretize/Curves.h"
+#include "Discretize/MarchingTetrahedra.h"
+#include "Discretize/Patches.h"
+#include "Discretize/Points.h"
+#include "Discretize/Surface.h"
 #include "FRep/Sampling.h"
 
 #include <algorithm>
@@ -114,82 +118,126 @@ discretize::ContourOptions contourOptions(const DiscretizationOptions& o, bool s
   return c;
 }
 
+discretize::CurveOptions curveOptions(const DiscretizationOptions& o, double step)
+{
+  discretize::CurveOptions c;
+  c.step = step;
+  c.tolerance = o.tolerance;
+  c.threads = o.threads;
+  return c;
+}
+
+discretize::PointOptions pointOptions(const DiscretizationOptions& o, double size)
+{
+  discretize::PointOptions p;
+  p.size = size;
+  p.tolerance = o.tolerance;
+  p.threads = o.threads;
+  return p;
+}
+
+/// Keeps the points where every inside field is >= 0 (to the projection tolerance, scaled).
+PointSet keepInside(
+  const PointSet& points, const std::vector<frep::FieldPtr>& inside, double tolerance)
+{
+  std::vector<std::unique_ptr<frep::FieldEvaluator>> fields;
+  for (const auto& f : inside)
+  {
+    fields.push_back(f->evaluator());
+  }
+  PointSet out;
+  for (std::size_t i = 0; i < points.points.size(); ++i)
+  {
+    bool keep = true;
+    for (auto& f : fields)
+    {
+      keep = keep && f->value(points.points[i]) >= -tolerance;
+    }
+    if (keep)
+    {
+      out.points.push_back(points.points[i]);
+    }
+  }
+  return out;
+}
+
 void discretizeImplicit(
   const Cell& c, const ImplicitGeometry& g, const DiscretizationOptions& o, CellMesh& out)
 {
-  discretize::ProjectionOptions projection;
-  projection.tolerance = o.tolerance;
   // Carriers are meshed a little beyond the cell's box, so that trimming, not the box, makes
   // the cell's edges.
   const Box3 box = padded(g.bounds, 2 * o.featureSize);
   switch (c.dimension)
   {
     case 3:
-      out.surface =
-        discretize::contourSurface(*intersection(g.inside), g.bounds, contourOptions(o, true));
+    {
+      // Solids by dual contouring: vertices placed by the QEF of the surface's tangent planes
+      // keep edges and corners sharp (CSG of solids, the cut by the box).
+      discretize::SurfaceOptions surface;
+      surface.featureSize = o.featureSize;
+      surface.threads = o.threads;
+      out.surface = discretize::contourSurface(*intersection(g.inside), g.bounds, surface);
       break;
+    }
     case 2:
     {
       SurfaceMesh carrier =
-        discretize::contourSurface(*g.carriers[0], box, contourOptions(o, false));
-      out.surface = g.inside.empty()
-        ? std::move(carrier)
-        : discretize::trimSurface(carrier, *g.carriers[0], g.inside, projection);
+        discretize::marchingTetrahedra(*g.carriers[0], box, contourOptions(o, false));
+      if (g.inside.empty())
+      {
+        out.surface = std::move(carrier);
+      }
+      else
+      {
+        discretize::TrimOptions trim;
+        trim.tolerance = o.tolerance;
+        trim.threads = o.threads;
+        out.surface = discretize::trimSurface(carrier, *g.carriers[0], g.inside, trim);
+      }
       break;
     }
     case 1:
-    {
-      const SurfaceMesh carrier =
-        discretize::contourSurface(*g.carriers[0], box, contourOptions(o, false));
-      out.curves =
-        discretize::curvesOnSurface(carrier, *g.carriers[0], *g.carriers[1], g.inside, projection);
+      out.curves = discretize::traceCurve(
+        *g.carriers[0], *g.carriers[1], g.inside, g.bounds, curveOptions(o, o.featureSize));
       break;
-    }
     default:
-    {
-      const PointSet found = discretize::solvePoints(
-        *g.carriers[0], *g.carriers[1], *g.carriers[2], g.bounds, o.featureSize / 4, projection);
-      out.points = discretize::keepInside(found, g.inside, 1e3 * o.tolerance);
-    }
+      out.points = keepInside(discretize::solvePoints(*g.carriers[0], *g.carriers[1],
+                                *g.carriers[2], g.bounds, pointOptions(o, o.featureSize / 4)),
+        g.inside, 1e3 * o.tolerance);
   }
 }
 
 void discretizeMapped(
   const Cell& c, const MappedGeometry& g, const DiscretizationOptions& o, CellMesh& out)
 {
-  discretize::ProjectionOptions projection;
-  projection.tolerance = o.tolerance;
   Box3 uv = g.uvBounds;
   uv.lo[2] = -1;
   uv.hi[2] = 1;
-  // The (u, v) step: h stretches the plane, so the feature size is an upper bound of the 3D edge
-  // only where h is no more than an isometry; a quarter of it keeps the mapped mesh fine enough
-  // for the maps of the models in Data/.
+  // The (u, v) step: h stretches the plane, so half the feature size keeps the mapped mesh fine
+  // enough for maps that stretch up to twice (those of the models in Data/).
   const double step = o.featureSize / 2;
-  std::vector<Point3>* points = nullptr;
-  std::vector<discretize::PointArray>* data = nullptr;
   switch (c.dimension)
   {
     case 2:
-      out.surface = discretize::triangulateRegion2D(*intersection(g.inside), uv, step);
-      points = &out.surface.points;
-      data = &out.surface.pointData;
+    {
+      discretize::Region2DOptions region;
+      region.size = step;
+      region.tolerance = o.tolerance;
+      region.threads = o.threads;
+      out.surface = discretize::triangulateRegion2D(*intersection(g.inside), uv, region);
+      discretize::mapToSpace(out.surface, *g.map[0], *g.map[1], *g.map[2]);
       break;
+    }
     case 1:
-      out.curves = discretize::curves2D(*g.carriers[0], g.inside, uv, step, projection);
-      points = &out.curves.points;
-      data = &out.curves.pointData;
+      out.curves = discretize::traceCurve2D(*g.carriers[0], g.inside, uv, curveOptions(o, step));
+      discretize::mapToSpace(out.curves, *g.map[0], *g.map[1], *g.map[2]);
       break;
     default:
-    {
-      const PointSet found = discretize::solvePoints(
-        *g.carriers[0], *g.carriers[1], *zField(), uv, step / 4, projection);
-      out.points = discretize::keepInside(found, g.inside, 1e3 * o.tolerance);
-      points = &out.points.points;
-      data = &out.points.pointData;
-    }
+      out.points = keepInside(discretize::solvePoints(*g.carriers[0], *g.carriers[1], *zField(), uv,
+                                pointOptions(o, step / 4)),
+        g.inside, 1e3 * o.tolerance);
+      discretize::mapToSpace(out.points, *g.map[0], *g.map[1], *g.map[2]);
   }
-  discretize::mapToSpace(*points, *data, *g.map[0], *g.map[1], *g.map[2]);
 }
 
 double defaultFeatureSize(const Complex& complex)
@@ -216,17 +264,28 @@ CellMesh discretizeCell(const Complex& complex, CellId id, const DiscretizationO
   CellMesh out;
   out.cell = id;
   out.dimension = c.dimension;
-  if (const auto* g = std::get_if<ExplicitGeometry>(&c.geometry))
+  try
   {
-    discretizeExplicit(c, *g, out);
+    if (const auto* g = std::get_if<ExplicitGeometry>(&c.geometry))
+    {
+      discretizeExplicit(c, *g, out);
+    }
+    else if (const auto* m = std::get_if<MappedGeometry>(&c.geometry))
+    {
+      discretizeMapped(c, *m, o, out);
+    }
+    else
+    {
+      discretizeImplicit(c, std::get<ImplicitGeometry>(c.geometry), o, out);
+    }
   }
-  else if (const auto* m = std::get_if<MappedGeometry>(&c.geometry))
+  catch (const frep::Cancelled&)
   {
-    discretizeMapped(c, *m, o, out);
+    throw;
   }
-  else
+  catch (const std::exception& e)
   {
-    discretizeImplicit(c, std::get<ImplicitGeometry>(c.geometry), o, out);
+    throw ComplexError("cell '" + c.name + "' cannot be discretised: " + e.what());
   }
   for (const auto& binding : c.attributes)
   {

@@ -3,6 +3,8 @@
 
 #include "FRep/Tape.h"
 #include "Lang/HyperFun.h"
+#include "Voxel/VdbIO.h"
+#include "Voxel/VoxelField.h"
 
 #include <nlohmann/json.hpp>
 
@@ -35,10 +37,12 @@ struct Problem
 class Reader
 {
 public:
-  Reader(const std::string& text, const std::string& fileName, const Limits& limits)
+  Reader(const std::string& text, const std::string& fileName, const Limits& limits,
+    const ComplexFileReaders& readers)
     : text_(text)
     , file_(fileName)
     , limits_(limits)
+    , readers_(readers)
   {
   }
 
@@ -431,8 +435,7 @@ private:
           readDerived(spec, c, k, where);
           break;
         case CellKind::Voxel:
-          report(where + ": voxel cells are read by the VTK layer (ictkComplexSource) for now",
-            current_);
+          readVoxel(spec, c, where);
           break;
         default:
           readImplicit(spec, c, where);
@@ -498,9 +501,82 @@ private:
     c.geometry = std::move(g);
   }
 
+  /// A V cell: the solid where a sampled scalar field is above (or below) an iso-value, read by
+  /// trilinear interpolation.
+  void readVoxel(const Json& spec, Cell& c, const std::string& where)
+  {
+    if (!spec.contains("file") || !spec["file"].is_string())
+    {
+      report(where + ": a voxel cell needs \"file\" (.vdb, or a VTK image through ictk)", current_);
+      return;
+    }
+    if (c.dimension != 3)
+    {
+      report(where + ": a voxel cell is a solid; its dimension must be 3", current_);
+      return;
+    }
+    const std::string path = resolve(spec["file"].get<std::string>());
+    const std::string array = spec.value("array", std::string());
+    const std::string side = spec.value("inside", std::string("above"));
+    if (side != "above" && side != "below")
+    {
+      report(where + ": \"inside\" must be \"above\" or \"below\" the iso-value", current_);
+      return;
+    }
+    const double iso = number(spec, "iso", 0.0, where + ": \"iso\"");
+    try
+    {
+      std::shared_ptr<voxel::VoxelGrid> grid;
+      const bool vdb = path.size() > 4 && path.compare(path.size() - 4, 4, ".vdb") == 0;
+      if (readers_.volume && !vdb)
+      {
+        grid = readers_.volume(path, array);
+      }
+      else if (vdb)
+      {
+        grid = voxel::readVdb(path, array);
+      }
+      else
+      {
+        throw std::invalid_argument("'" + path +
+          "': only .vdb volumes are read without the VTK layer (use ictk or ictkComplexSource)");
+      }
+      voxel::validate(*grid, "'" + path + "'");
+      complex::ImplicitGeometry g;
+      g.bounds = grid->bounds();
+      g.inside.push_back(voxel::voxelField(grid, iso, side == "above"));
+      g.insideText.push_back(path + (side == "above" ? " >= " : " <= ") + std::to_string(iso));
+      c.geometry = std::move(g);
+    }
+    catch (const std::exception& e)
+    {
+      report(where + ": " + e.what(), current_);
+    }
+  }
+
   void readExplicit(const Json& spec, Cell& c, const std::string& where)
   {
     complex::ExplicitGeometry g;
+    if (spec.contains("file"))
+    {
+      if (!readers_.mesh)
+      {
+        report(where +
+            ": explicit cells from files are read by the VTK layer (ictk, "
+            "ictkComplexSource)",
+          current_);
+        return;
+      }
+      try
+      {
+        c.geometry = readers_.mesh(resolve(spec.value("file", std::string())));
+      }
+      catch (const std::exception& e)
+      {
+        report(where + ": " + e.what(), current_);
+      }
+      return;
+    }
     if (spec.contains("curve"))
     {
       readCurve(spec["curve"], g, where);
@@ -775,6 +851,7 @@ private:
   const std::string& text_;
   std::string file_;
   Limits limits_;
+  ComplexFileReaders readers_;
   double time_ = 0;
   std::string library_;
   std::string libraryName_;
@@ -797,8 +874,8 @@ bool isComplexFile(const std::string& path)
   return ext == ".json";
 }
 
-complex::Complex readComplexJson(
-  const std::string& text, const std::string& fileName, const Limits& limits)
+complex::Complex readComplexJson(const std::string& text, const std::string& fileName,
+  const Limits& limits, const ComplexFileReaders& readers)
 {
   if (text.size() > limits.maxFileBytes)
   {
@@ -808,10 +885,11 @@ complex::Complex readComplexJson(
       "the file is larger than the limit of " + std::to_string(limits.maxFileBytes) + " bytes";
     throw ParseError({ d });
   }
-  return Reader(text, fileName, limits).read();
+  return Reader(text, fileName, limits, readers).read();
 }
 
-complex::Complex readComplexFile(const std::string& path, const Limits& limits)
+complex::Complex readComplexFile(
+  const std::string& path, const Limits& limits, const ComplexFileReaders& readers)
 {
   std::ifstream in(path, std::ios::binary);
   if (!in)
@@ -823,7 +901,7 @@ complex::Complex readComplexFile(const std::string& path, const Limits& limits)
   }
   std::ostringstream s;
   s << in.rdbuf();
-  return readComplexJson(s.str(), path, limits);
+  return readComplexJson(s.str(), path, limits, readers);
 }
 
 } // namespace ictk::lang

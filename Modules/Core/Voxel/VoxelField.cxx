@@ -73,17 +73,41 @@ public:
     }
   }
 
-  /// Exact min/max of the vertex values of cells c0[a]..c1[a] (inclusive, valid cell indices).
-  MinMax query(const std::array<std::int64_t, 3>& c0, const std::array<std::int64_t, 3>& c1) const
+  /// A block of level 0 that a query covers only in part: cells lo..hi of block b.
+  struct Partial
+  {
+    std::array<std::int64_t, 3> b, lo, hi;
+  };
+
+  /// Boxes of cells with at most this many vertices get the exact min/max; larger ones take the
+  /// 8^3 blocks they cover only in part whole (an enclosure, looser by the values within 8 cells
+  /// of the box), so that a query costs about the number of blocks touched.
+  static constexpr std::int64_t kExactVertices = 64 * 64 * 64;
+
+  /// Min/max of the vertex values of cells c0[a]..c1[a] (inclusive, valid cell indices): exact
+  /// up to kExactVertices vertices, an enclosure above. `partials` is scratch space.
+  MinMax query(const std::array<std::int64_t, 3>& c0, const std::array<std::int64_t, 3>& c1,
+    std::vector<Partial>& partials) const
   {
     MinMax r;
     const std::int64_t vertices = (c1[0] - c0[0] + 2) * (c1[1] - c0[1] + 2) * (c1[2] - c0[2] + 2);
-    if (vertices <= 64)
+    if (vertices <= kBlock * kBlock * kBlock)
     {
       scan(c0, c1, r);
       return r;
     }
-    visit(levels_.size() - 1, { 0, 0, 0 }, c0, c1, r);
+    partials.clear();
+    visit(levels_.size() - 1, { 0, 0, 0 }, c0, c1, vertices <= kExactVertices, r, partials);
+    // The covered blocks are in r; a partly covered block needs scanning only when its whole
+    // range is not already inside r (rarely, for smooth data).
+    for (const Partial& p : partials)
+    {
+      const MinMax& m = levels_[0].at(p.b);
+      if (m.lo < r.lo || m.hi > r.hi)
+      {
+        scan(p.lo, p.hi, r);
+      }
+    }
     return r;
   }
 
@@ -99,8 +123,8 @@ private:
     }
   };
 
-  void scan(const std::array<std::int64_t, 3>& c0, const std::array<std::int64_t, 3>& c1,
-    MinMax& r) const
+  void scan(
+    const std::array<std::int64_t, 3>& c0, const std::array<std::int64_t, 3>& c1, MinMax& r) const
   {
     const std::int64_t nx = grid_.dimensions[0];
     const std::int64_t nxy = nx * grid_.dimensions[1];
@@ -164,8 +188,8 @@ private:
             for (std::int64_t k = b[2] * kBlock; k < std::min((b[2] + 1) * kBlock, fine.dims[2]);
                  ++k)
             {
-              for (std::int64_t j = b[1] * kBlock;
-                   j < std::min((b[1] + 1) * kBlock, fine.dims[1]); ++j)
+              for (std::int64_t j = b[1] * kBlock; j < std::min((b[1] + 1) * kBlock, fine.dims[1]);
+                   ++j)
               {
                 for (std::int64_t i = b[0] * kBlock;
                      i < std::min((b[0] + 1) * kBlock, fine.dims[0]); ++i)
@@ -181,8 +205,8 @@ private:
   }
 
   void visit(std::size_t li, const std::array<std::int64_t, 3>& b,
-    const std::array<std::int64_t, 3>& c0, const std::array<std::int64_t, 3>& c1,
-    MinMax& r) const
+    const std::array<std::int64_t, 3>& c0, const std::array<std::int64_t, 3>& c1, bool exact,
+    MinMax& r, std::vector<Partial>& partials) const
   {
     const Level& level = levels_[li];
     std::array<std::int64_t, 3> lo;
@@ -203,7 +227,14 @@ private:
     }
     if (li == 0)
     {
-      scan(lo, hi, r);
+      if (exact)
+      {
+        partials.push_back({ b, lo, hi });
+      }
+      else
+      {
+        r.add(level.at(b));
+      }
       return;
     }
     const std::int64_t child = levels_[li - 1].size;
@@ -213,7 +244,7 @@ private:
       {
         for (std::int64_t i = lo[0] / child; i <= hi[0] / child; ++i)
         {
-          visit(li - 1, { i, j, k }, lo, hi, r);
+          visit(li - 1, { i, j, k }, lo, hi, exact, r, partials);
         }
       }
     }
@@ -235,32 +266,41 @@ double lipschitzOf(const VoxelGrid& g)
     tbb::blocked_range<std::int64_t>(0, nz), D3{ 0, 0, 0 },
     [&](const tbb::blocked_range<std::int64_t>& r, D3 m)
     {
+      const float* v = g.values.data();
       for (std::int64_t k = r.begin(); k != r.end(); ++k)
       {
         for (std::int64_t j = 0; j < ny; ++j)
         {
-          for (std::int64_t i = 0; i < nx; ++i)
+          const float* row = v + nx * (j + ny * k);
+          const float* rowY = j + 1 < ny ? row + nx : nullptr;
+          const float* rowZ = k + 1 < nz ? row + nx * ny : nullptr;
+          double mx = 0, my = 0, mz = 0;
+          for (std::int64_t i = 0; i + 1 < nx; ++i)
           {
-            const double v = g.at(i, j, k);
-            if (i + 1 < nx)
+            mx = std::max(mx, std::abs(double(row[i + 1]) - double(row[i])));
+          }
+          if (rowY)
+          {
+            for (std::int64_t i = 0; i < nx; ++i)
             {
-              m[0] = std::max(m[0], std::abs(double(g.at(i + 1, j, k)) - v));
-            }
-            if (j + 1 < ny)
-            {
-              m[1] = std::max(m[1], std::abs(double(g.at(i, j + 1, k)) - v));
-            }
-            if (k + 1 < nz)
-            {
-              m[2] = std::max(m[2], std::abs(double(g.at(i, j, k + 1)) - v));
+              my = std::max(my, std::abs(double(rowY[i]) - double(row[i])));
             }
           }
+          if (rowZ)
+          {
+            for (std::int64_t i = 0; i < nx; ++i)
+            {
+              mz = std::max(mz, std::abs(double(rowZ[i]) - double(row[i])));
+            }
+          }
+          m = { std::max(m[0], mx), std::max(m[1], my), std::max(m[2], mz) };
         }
       }
       return m;
     },
-    [](const D3& a, const D3& b)
-    { return D3{ std::max(a[0], b[0]), std::max(a[1], b[1]), std::max(a[2], b[2]) }; });
+    [](const D3& a, const D3& b) {
+      return D3{ std::max(a[0], b[0]), std::max(a[1], b[1]), std::max(a[2], b[2]) };
+    });
   const double lx = d[0] / g.spacing[0];
   const double ly = d[1] / g.spacing[1];
   const double lz = d[2] / g.spacing[2];
@@ -366,7 +406,7 @@ public:
       }
       hu[a] = up;
     }
-    const MinMax m = d.pyramid->query(c0, c1);
+    const MinMax m = d.pyramid->query(c0, c1, partials_);
     const double flo = d.above ? d.F(m.lo) : d.F(m.hi);
     const double fhi = d.above ? d.F(m.hi) : d.F(m.lo);
     const double glo = d.scale * VoxelData::G(hl[0], hl[1], hl[2]);
@@ -405,8 +445,7 @@ private:
     const std::int64_t nxy = nx * g.dimensions[1];
     const float* v0 = g.values.data() + c[0] + nx * c[1] + nxy * c[2];
     const double v000 = v0[0], v100 = v0[1], v010 = v0[nx], v110 = v0[nx + 1];
-    const double v001 = v0[nxy], v101 = v0[nxy + 1], v011 = v0[nxy + nx],
-                 v111 = v0[nxy + nx + 1];
+    const double v001 = v0[nxy], v101 = v0[nxy + 1], v011 = v0[nxy + nx], v111 = v0[nxy + nx + 1];
     const double tx = t[0], ty = t[1], tz = t[2];
     const double a00 = v000 + tx * (v100 - v000);
     const double a10 = v010 + tx * (v110 - v010);
@@ -479,6 +518,7 @@ private:
   }
 
   std::shared_ptr<const VoxelData> d_;
+  std::vector<Pyramid::Partial> partials_;
 };
 
 class VoxelFieldImpl final : public frep::Field

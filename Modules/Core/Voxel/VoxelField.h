@@ -21,10 +21,15 @@
 // - the zero set inside the open box G is exactly the iso-surface of the trilinear interpolant.
 //
 // bound(box) encloses f over the box with no rounding slack needed: the values of f come from a
-// convex combination of the vertex values of the cells the (clamped) box touches, and the exact
-// enclosure of those values is read from a min/max pyramid (blocks of 8^3 cells, then 8^3 blocks,
-// ...) built once when the field is created. Combined with the exact range of L * d_G over the
-// box, bound() is tight for a constant grid.
+// convex combination of the vertex values of the cells the (clamped) box touches, and min/max of
+// those values come from a min/max pyramid (blocks of 8^3 cells, then 8^3 blocks, ...) built once
+// when the field is created. For boxes touching at most 64^3 vertices the min/max is exact (the
+// values of those cells: the blocks the box covers in part are scanned, unless their own min/max
+// already lies within the range found, which is the common case for smooth data); for larger
+// boxes the partly covered 8^3 blocks count whole (still an enclosure, looser by the values
+// within 8 cells of the box), so a query costs about the number of blocks touched rather than
+// the box's surface in voxels. Combined with the exact range of
+// L * d_G over the box, bound() is tight for a constant grid.
 //
 // gradient() is the gradient of the piece that gives the value (the trilinear interpolant's
 // within the cell holding the clamped point, zero along clamped axes; or L times d_G's). On a

@@ -46,9 +46,8 @@ void validate(const VoxelGrid& grid, const std::string& what)
       !(grid.spacing[a] > 0) || !std::isfinite(far))
     {
       std::ostringstream os;
-      os << what << ": origin " << grid.origin[a] << " and spacing " << grid.spacing[a]
-         << " along " << names[a]
-         << " must be finite, with a positive spacing and a finite far corner";
+      os << what << ": origin " << grid.origin[a] << " and spacing " << grid.spacing[a] << " along "
+         << names[a] << " must be finite, with a positive spacing and a finite far corner";
       throw std::invalid_argument(os.str());
     }
   }
@@ -58,10 +57,9 @@ void validate(const VoxelGrid& grid, const std::string& what)
   }
   if (static_cast<std::int64_t>(grid.values.size()) != grid.pointCount())
   {
-    throw std::invalid_argument(what + ": " + std::to_string(grid.values.size()) +
-      " values for " + std::to_string(grid.dimensions[0]) + " x " +
-      std::to_string(grid.dimensions[1]) + " x " + std::to_string(grid.dimensions[2]) + " = " +
-      std::to_string(grid.pointCount()) + " points");
+    throw std::invalid_argument(what + ": " + std::to_string(grid.values.size()) + " values for " +
+      std::to_string(grid.dimensions[0]) + " x " + std::to_string(grid.dimensions[1]) + " x " +
+      std::to_string(grid.dimensions[2]) + " = " + std::to_string(grid.pointCount()) + " points");
   }
   std::int64_t first = -1;
   std::int64_t bad = 0;
@@ -82,8 +80,8 @@ void validate(const VoxelGrid& grid, const std::string& what)
     const std::int64_t j = (first / grid.dimensions[0]) % grid.dimensions[1];
     const std::int64_t k = first / (grid.dimensions[0] * grid.dimensions[1]);
     std::ostringstream os;
-    os << what << ": value " << grid.values[static_cast<std::size_t>(first)] << " at point ("
-       << i << ", " << j << ", " << k << ") (index " << first << ") is not finite";
+    os << what << ": value " << grid.values[static_cast<std::size_t>(first)] << " at point (" << i
+       << ", " << j << ", " << k << ") (index " << first << ") is not finite";
     if (bad > 1)
     {
       os << " (" << bad << " non-finite values in all)";

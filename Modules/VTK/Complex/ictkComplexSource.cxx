@@ -4,23 +4,41 @@
 #include "Complex/Discretization.h"
 #include "FRep/Sampling.h"
 #include "Lang/ComplexFile.h"
+#include "Voxel/VoxelGrid.h"
 
 #include "vtkCellArray.h"
+#include "vtkCellType.h"
 #include "vtkDataAssembly.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
+#include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkIntArray.h"
+#include "vtkMatrix3x3.h"
+#include "vtkMetaImageReader.h"
 #include "vtkMultiBlockDataSet.h"
+#include "vtkNIFTIImageReader.h"
+#include "vtkNrrdReader.h"
+#include "vtkOBJReader.h"
 #include "vtkObjectFactory.h"
+#include "vtkPLYReader.h"
 #include "vtkPartitionedDataSet.h"
 #include "vtkPartitionedDataSetCollection.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkSTLReader.h"
 #include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
+#include "vtkTriangleFilter.h"
+#include "vtkUnstructuredGrid.h"
+#include "vtkXMLImageDataReader.h"
+#include "vtkXMLPolyDataReader.h"
+#include "vtkXMLUnstructuredGridReader.h"
 
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
 #include <map>
 
 vtkStandardNewMacro(ictkComplexSource);
@@ -85,6 +103,178 @@ vtkSmartPointer<vtkPolyData> toPolyData(const complex::CellMesh& m)
   return pd;
 }
 
+bool endsWith(std::string s, const std::string& suffix)
+{
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s.size() >= suffix.size() &&
+    s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+/// Runs a VTK reader and fails with the file's name when it reports an error or reads nothing.
+template <typename Reader>
+vtkSmartPointer<Reader> readWith(const std::string& path)
+{
+  if (FILE* f = std::fopen(path.c_str(), "rb"))
+  {
+    std::fclose(f);
+  }
+  else
+  {
+    throw std::invalid_argument("cannot open '" + path + "'");
+  }
+  auto reader = vtkSmartPointer<Reader>::New();
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetErrorCode() != 0 || !reader->GetOutputDataObject(0))
+  {
+    throw std::invalid_argument("cannot read '" + path + "'");
+  }
+  return reader;
+}
+
+complex::ExplicitGeometry readMesh(const std::string& path)
+{
+  vtkSmartPointer<vtkDataSet> data;
+  if (endsWith(path, ".vtu"))
+  {
+    data = readWith<vtkXMLUnstructuredGridReader>(path)->GetOutput();
+  }
+  else if (endsWith(path, ".vtp"))
+  {
+    data = readWith<vtkXMLPolyDataReader>(path)->GetOutput();
+  }
+  else if (endsWith(path, ".stl"))
+  {
+    data = readWith<vtkSTLReader>(path)->GetOutput();
+  }
+  else if (endsWith(path, ".ply"))
+  {
+    data = readWith<vtkPLYReader>(path)->GetOutput();
+  }
+  else if (endsWith(path, ".obj"))
+  {
+    data = readWith<vtkOBJReader>(path)->GetOutput();
+  }
+  else
+  {
+    throw std::invalid_argument(
+      "'" + path + "': explicit cells are read from .vtp, .vtu, .stl, .ply or .obj files");
+  }
+  if (data->GetNumberOfPoints() == 0)
+  {
+    throw std::invalid_argument("'" + path + "' has no points");
+  }
+  complex::ExplicitGeometry g;
+  g.points.resize(static_cast<std::size_t>(data->GetNumberOfPoints()));
+  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i)
+  {
+    data->GetPoint(i, g.points[static_cast<std::size_t>(i)].data());
+  }
+  if (auto* grid = vtkUnstructuredGrid::SafeDownCast(data))
+  {
+    for (vtkIdType c = 0; c < grid->GetNumberOfCells(); ++c)
+    {
+      if (grid->GetCellType(c) != VTK_TETRA)
+      {
+        throw std::invalid_argument("'" + path + "': cell " + std::to_string(c) +
+          " is not a tetrahedron (an explicit solid is a tetrahedral mesh)");
+      }
+      vtkIdType n = 0;
+      const vtkIdType* ids = nullptr;
+      grid->GetCellPoints(c, n, ids);
+      g.tetrahedra.push_back(
+        { static_cast<std::uint32_t>(ids[0]), static_cast<std::uint32_t>(ids[1]),
+          static_cast<std::uint32_t>(ids[2]), static_cast<std::uint32_t>(ids[3]) });
+    }
+    return g;
+  }
+  // Polygons are triangulated; the highest dimension present makes the cell.
+  vtkNew<vtkTriangleFilter> triangles;
+  triangles->SetInputData(data);
+  triangles->PassVertsOn();
+  triangles->PassLinesOn();
+  triangles->Update();
+  vtkPolyData* pd = triangles->GetOutput();
+  vtkIdType n = 0;
+  const vtkIdType* ids = nullptr;
+  vtkCellArray* polys = pd->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(n, ids);)
+  {
+    g.triangles.push_back({ static_cast<std::uint32_t>(ids[0]), static_cast<std::uint32_t>(ids[1]),
+      static_cast<std::uint32_t>(ids[2]) });
+  }
+  if (g.triangles.empty())
+  {
+    vtkCellArray* lines = pd->GetLines();
+    for (lines->InitTraversal(); lines->GetNextCell(n, ids);)
+    {
+      g.polylines.emplace_back(ids, ids + n);
+    }
+  }
+  return g;
+}
+
+std::shared_ptr<voxel::VoxelGrid> readVolume(const std::string& path, const std::string& array)
+{
+  vtkSmartPointer<vtkImageData> image;
+  if (endsWith(path, ".vti"))
+  {
+    image = readWith<vtkXMLImageDataReader>(path)->GetOutput();
+  }
+  else if (endsWith(path, ".mha") || endsWith(path, ".mhd"))
+  {
+    image = readWith<vtkMetaImageReader>(path)->GetOutput();
+  }
+  else if (endsWith(path, ".nii") || endsWith(path, ".nii.gz"))
+  {
+    image = readWith<vtkNIFTIImageReader>(path)->GetOutput();
+  }
+  else if (endsWith(path, ".nrrd") || endsWith(path, ".nhdr"))
+  {
+    image = readWith<vtkNrrdReader>(path)->GetOutput();
+  }
+  else
+  {
+    throw std::invalid_argument("'" + path +
+      "': voxel cells are read from .vdb, .vti, .mha/.mhd, .nii/.nii.gz or .nrrd/.nhdr files");
+  }
+  vtkDataArray* scalars = array.empty() ? image->GetPointData()->GetScalars()
+                                        : image->GetPointData()->GetArray(array.c_str());
+  if (!scalars && array.empty() && image->GetPointData()->GetNumberOfArrays() > 0)
+  {
+    scalars = image->GetPointData()->GetArray(0);
+  }
+  if (!scalars)
+  {
+    throw std::invalid_argument("'" + path + "' has no point array" +
+      (array.empty() ? std::string() : " named '" + array + "'"));
+  }
+  if (vtkMatrix3x3* d = image->GetDirectionMatrix())
+  {
+    if (!d->IsIdentity())
+    {
+      throw std::invalid_argument(
+        "'" + path + "' has a rotated grid (direction matrix); resample it to the axes first");
+    }
+  }
+  auto grid = std::make_shared<voxel::VoxelGrid>();
+  int dims[3];
+  image->GetDimensions(dims);
+  for (int a = 0; a < 3; ++a)
+  {
+    grid->dimensions[a] = dims[a];
+    grid->origin[a] = image->GetOrigin()[a];
+    grid->spacing[a] = image->GetSpacing()[a];
+  }
+  const vtkIdType count = image->GetNumberOfPoints();
+  grid->values.resize(static_cast<std::size_t>(count));
+  for (vtkIdType i = 0; i < count; ++i)
+  {
+    grid->values[static_cast<std::size_t>(i)] = static_cast<float>(scalars->GetComponent(i, 0));
+  }
+  return grid;
+}
+
 template <typename T, typename V>
 void addField(vtkFieldData* fd, const char* name, V value)
 {
@@ -107,6 +297,14 @@ void ictkComplexSource::SetComplex(std::shared_ptr<const ictk::complex::Complex>
 {
   this->Complex = std::move(complex);
   this->Modified();
+}
+
+complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path)
+{
+  lang::ComplexFileReaders readers;
+  readers.mesh = readMesh;
+  readers.volume = readVolume;
+  return lang::readComplexFile(path, {}, readers);
 }
 
 void ictkComplexSource::Convert(const complex::Complex& k, const complex::ComplexMesh& mesh,
@@ -224,7 +422,7 @@ int ictkComplexSource::RequestData(
         vtkErrorMacro("no complex: set FileName (a .json complex) or a complex in C++");
         return 0;
       }
-      k = std::make_shared<const complex::Complex>(lang::readComplexFile(this->FileName));
+      k = std::make_shared<const complex::Complex>(ReadComplexFile(this->FileName));
     }
     complex::DiscretizationOptions options;
     options.featureSize = this->FeatureSize;

@@ -3,7 +3,8 @@
  * @class ictkComplexSource
  * @brief Discretises an implicit complex and outputs it as a vtkPartitionedDataSetCollection.
  *
- * The complex comes from a .json complex file (SetFileName) or, in C++, from SetComplex(). Every
+ * The complex comes from a .json complex file (SetFileName; cells may name VTK mesh and image
+ * files, see ReadComplexFile) or, in C++, from SetComplex(). Every
  * cell is discretised by its dimension (points, traced polylines, trimmed or mapped triangle
  * patches, boundary surfaces of solids) at FeatureSize, and becomes one partitioned dataset
  * holding a vtkPolyData whose point data carries every attribute of the complex.
@@ -66,6 +67,10 @@ public:
   static void ToMultiBlock(vtkPartitionedDataSetCollection* input, vtkMultiBlockDataSet* output);
 
 #ifndef __VTK_WRAP__
+  /// Reads a .json complex with VTK's readers for the cells' files: explicit cells from .vtp,
+  /// .vtu, .stl, .ply, .obj; voxel cells from .vti, .mha/.mhd, .nii/.nii.gz, .nrrd/.nhdr (and
+  /// .vdb through the core). Throws ictk::lang::ParseError.
+  static ictk::complex::Complex ReadComplexFile(const std::string& path);
   /// A complex built in C++; used instead of FileName when set.
   void SetComplex(std::shared_ptr<const ictk::complex::Complex> complex);
   /// The VTK form of a discretised complex.

@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Complexes through VTK: a voxel cell read from a .vti image, an explicit cell read from an .stl
+// file, the containment of an FRep ball in the voxel cell proved by validation, and the
+// partitioned dataset collection ictkComplexSource makes of them.
+
+#include "Complex/Validation.h"
+#include "ictkComplexSource.h"
+
+#include <vtkCubeSource.h>
+#include <vtkFieldData.h>
+#include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPartitionedDataSet.h>
+#include <vtkPartitionedDataSetCollection.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkSTLWriter.h>
+#include <vtkStringArray.h>
+#include <vtkTriangleFilter.h>
+#include <vtkXMLImageDataWriter.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace
+{
+
+struct Files
+{
+  std::filesystem::path dir;
+  Files()
+  {
+    dir =
+      std::filesystem::temp_directory_path() / ("ictk-complex-vtk-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+  }
+  ~Files() { std::filesystem::remove_all(dir); }
+  std::string path(const std::string& name) const { return (dir / name).string(); }
+};
+
+/// A 64^3 image of 0.8 - |p| over [-1, 1]^3: a ball of radius 0.8 sampled on voxels of 2/63.
+void writeSphereImage(const std::string& path)
+{
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(64, 64, 64);
+  image->SetOrigin(-1, -1, -1);
+  const double h = 2.0 / 63;
+  image->SetSpacing(h, h, h);
+  vtkNew<vtkFloatArray> values;
+  values->SetName("density");
+  values->SetNumberOfTuples(64 * 64 * 64);
+  for (int k = 0; k < 64; ++k)
+  {
+    for (int j = 0; j < 64; ++j)
+    {
+      for (int i = 0; i < 64; ++i)
+      {
+        const double x = -1 + i * h, y = -1 + j * h, z = -1 + k * h;
+        values->SetValue(
+          (k * 64 + j) * 64 + i, static_cast<float>(0.8 - std::sqrt(x * x + y * y + z * z)));
+      }
+    }
+  }
+  image->GetPointData()->SetScalars(values);
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  writer->SetFileName(path.c_str());
+  ASSERT_EQ(writer->Write(), 1);
+}
+
+void writeCube(const std::string& path)
+{
+  vtkNew<vtkCubeSource> cube;
+  cube->SetCenter(3, 0, 0);
+  vtkNew<vtkTriangleFilter> triangles;
+  triangles->SetInputConnection(cube->GetOutputPort());
+  vtkNew<vtkSTLWriter> writer;
+  writer->SetInputConnection(triangles->GetOutputPort());
+  writer->SetFileName(path.c_str());
+  ASSERT_EQ(writer->Write(), 1);
+}
+
+vtkPolyData* partition(vtkPartitionedDataSetCollection* pdc, const std::string& name)
+{
+  for (unsigned int i = 0; i < pdc->GetNumberOfPartitionedDataSets(); ++i)
+  {
+    auto* leaf = vtkPolyData::SafeDownCast(pdc->GetPartitionedDataSet(i)->GetPartition(0));
+    auto* names = vtkStringArray::SafeDownCast(leaf->GetFieldData()->GetAbstractArray("CellName"));
+    if (names && names->GetValue(0) == name)
+    {
+      return leaf;
+    }
+  }
+  return nullptr;
+}
+
+} // namespace
+
+TEST(ComplexVTK, VoxelAndMeshCellsFromFiles)
+{
+  Files files;
+  writeSphereImage(files.path("sphere.vti"));
+  writeCube(files.path("cube.stl"));
+  std::ofstream(files.path("scene.json")) << R"({
+  "name": "scene",
+  "cells": [
+    { "name": "scan", "kind": "V", "dimension": 3, "file": "sphere.vti", "array": "density",
+      "iso": 0, "inside": "above" },
+    { "name": "implant", "kind": "F", "dimension": 3, "inside": ["0.25 - x[1]^2 - x[2]^2 - x[3]^2"],
+      "bounds": [[-0.5, -0.5, -0.5], [0.5, 0.5, 0.5]] },
+    { "name": "box", "kind": "B", "dimension": 2, "file": "cube.stl" }
+  ],
+  "relations": { "containment": [["scan", "implant"]] }
+})";
+  const ictk::complex::Complex k = ictkComplexSource::ReadComplexFile(files.path("scene.json"));
+  ASSERT_EQ(k.cellCount(), 3u);
+  EXPECT_EQ(k.cell(k.idOf("scan")).kind, ictk::complex::CellKind::Voxel);
+
+  const double h = 2.0 / 63;
+  ictk::complex::DiscretizationOptions o;
+  o.featureSize = h;
+  const ictk::complex::ComplexMesh mesh = ictk::complex::discretizeComplex(k, o);
+  // The voxel cell's surface lies within half a voxel of the analytic sphere of radius 0.8.
+  const auto& scan = mesh.of(k.idOf("scan")).surface;
+  ASSERT_GT(scan.triangles.size(), 1000u);
+  double worst = 0;
+  for (const auto& p : scan.points)
+  {
+    worst = std::max(worst, std::abs(std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) - 0.8));
+  }
+  EXPECT_LT(worst, 0.5 * h);
+  // The explicit cube: 12 triangles, closed.
+  const auto& box = mesh.of(k.idOf("box")).surface;
+  EXPECT_EQ(box.triangles.size(), 12u);
+  EXPECT_TRUE(ictk::discretize::analyzeTopology(box).closed());
+  // Rc^{33} (scan, implant) holds, proved by interval arithmetic on the voxel field.
+  const ictk::complex::ValidationReport report = ictk::complex::validateComplex(k, mesh);
+  EXPECT_TRUE(report.ok()) << report.text(k);
+  ASSERT_EQ(report.satisfied.size(), 1u);
+
+  // A ball that pokes out of the scan: the containment is violated, with a witness outside.
+  std::ofstream(files.path("bad.json")) << R"({
+  "cells": [
+    { "name": "scan", "kind": "V", "dimension": 3, "file": "sphere.vti", "iso": 0 },
+    { "name": "implant", "kind": "F", "dimension": 3,
+      "inside": ["0.25 - (x[1] - 0.5)^2 - x[2]^2 - x[3]^2"], "bounds": [[0, -0.5, -0.5], [1, 0.5, 0.5]] }
+  ],
+  "relations": { "containment": [["scan", "implant"]] }
+})";
+  const ictk::complex::Complex bad = ictkComplexSource::ReadComplexFile(files.path("bad.json"));
+  const ictk::complex::ValidationReport badReport =
+    ictk::complex::validateComplex(bad, ictk::complex::discretizeComplex(bad, o));
+  ASSERT_EQ(badReport.violated.size(), 1u);
+  const auto& w = badReport.violated[0].witness;
+  EXPECT_GT(std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), 0.8);
+
+  // The VTK form: one partitioned dataset per cell with its field data.
+  vtkNew<ictkComplexSource> source;
+  source->SetFileName(files.path("scene.json").c_str());
+  source->SetFeatureSize(h);
+  source->Update();
+  vtkPartitionedDataSetCollection* pdc = source->GetOutput();
+  ASSERT_EQ(pdc->GetNumberOfPartitionedDataSets(), 3u);
+  vtkPolyData* scanData = partition(pdc, "scan");
+  ASSERT_NE(scanData, nullptr);
+  EXPECT_EQ(scanData->GetNumberOfPolys(), static_cast<vtkIdType>(scan.triangles.size()));
+  auto* kind = vtkStringArray::SafeDownCast(scanData->GetFieldData()->GetAbstractArray("CellKind"));
+  ASSERT_NE(kind, nullptr);
+  EXPECT_EQ(kind->GetValue(0), "V");
+}
+
+TEST(ComplexVTK, UnreadableFilesNameTheCellAndFile)
+{
+  Files files;
+  std::ofstream(files.path("missing.json")) << R"({
+  "cells": [ { "name": "scan", "kind": "V", "dimension": 3, "file": "nowhere.vti" },
+             { "name": "part", "kind": "B", "dimension": 2, "file": "nowhere.stl" } ]
+})";
+  try
+  {
+    ictkComplexSource::ReadComplexFile(files.path("missing.json"));
+    FAIL();
+  }
+  catch (const std::exception& e)
+  {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("cell 'scan': cannot open '"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("nowhere.vti'"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("cell 'part': cannot open '"));
+  }
+  // A source with a bad file fails the request with an error, and leaves an empty output.
+  vtkNew<ictkComplexSource> source;
+  source->SetFileName(files.path("missing.json").c_str());
+  source->SetGlobalWarningDisplay(0);
+  source->Update();
+  EXPECT_EQ(source->GetOutput()->GetNumberOfPartitionedDataSets(), 0u);
+}
