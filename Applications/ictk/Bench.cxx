@@ -9,12 +9,19 @@
 //                         132 ms)
 //   csg3-512              frep::sampleGrid of the bundled csg3 at 512^3 (float) against
 //                         vtkSampleFunction on the equivalent vtkImplicitBoolean
+//   sphere-gyroid-0.025   dual contouring of libfive's sphereGyroid over [-5,5]^3 at feature
+//                         size 0.025, 2 threads (libfive: 4.74 s)
+//   flower-256            the discretisation of every cell of Data/Models/flower/flower.json at
+//                         1/256 of its size (surfaces, patches, traced curves, points)
 #include "Bench.h"
 
+#include "Complex/Discretization.h"
+#include "Discretize/Surface.h"
 #include "FRep/BundledModels.h"
 #include "FRep/ModelRegistry.h"
 #include "FRep/Render.h"
 #include "FRep/Sampling.h"
+#include "Lang/ComplexFile.h"
 #include "Lang/VmReader.h"
 
 #include <vtkBox.h>
@@ -342,6 +349,76 @@ Result Csg3(int size)
 
 // --- output -------------------------------------------------------------------------------------
 
+Result SphereGyroid(double featureSize)
+{
+  Result r;
+  std::ostringstream name;
+  name << "sphere-gyroid-" << featureSize;
+  r.workload = name.str();
+  r.what = "manifold dual contouring of libfive's sphereGyroid over [-5,5]^3";
+  r.threads = ThreadsOr(2);
+  r.unit = "Mtriangles/s";
+  if (featureSize == 0.025)
+  {
+    r.reference = "libfive 4.74 s on a 2-core machine";
+    r.referenceSeconds = 4.74;
+    r.goalSeconds = 4.74 / 3;
+  }
+  const frep::FieldPtr field = frep::tapeField(frep::Tape::compile(bundled::sphereGyroidField()));
+  discretize::SurfaceOptions options;
+  options.featureSize = featureSize;
+  options.threads = r.threads;
+  discretize::SurfaceMesh mesh;
+  r.allSeconds = Time(
+    Options.Runs,
+    [&] {
+      mesh = discretize::contourSurface(*field, { { -5, -5, -5 }, { 5, 5, 5 } }, options);
+    },
+    &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  r.work = static_cast<double>(mesh.triangles.size());
+  const discretize::MeshTopology t = discretize::analyzeTopology(mesh);
+  r.details["triangles"] = mesh.triangles.size();
+  r.details["manifold"] = t.manifold();
+  r.details["closed"] = t.closed();
+  return r;
+}
+
+Result Flower(int divisions)
+{
+  Result r;
+  r.workload = "flower-" + std::to_string(divisions);
+  r.what = "discretisation of every cell of the seed 001 flower complex at 1/" +
+    std::to_string(divisions) + " of its size";
+  r.threads = ThreadsOr(2);
+  r.unit = "Mpoints/s";
+  const std::string path = std::string(ICTK_DATA_DIR) + "/Models/flower/flower.json";
+  const complex::Complex k = lang::readComplexFile(path);
+  const frep::Box3 box = complex::complexBounds(k);
+  double side = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    side = std::max(side, box.hi[a] - box.lo[a]);
+  }
+  complex::DiscretizationOptions options;
+  options.featureSize = side / divisions;
+  options.threads = r.threads;
+  complex::ComplexMesh mesh;
+  r.allSeconds = Time(
+    Options.Runs, [&] { mesh = complex::discretizeComplex(k, options); }, &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  std::size_t points = 0;
+  for (const auto& m : mesh.cells)
+  {
+    points += m.vertices().size();
+  }
+  r.work = static_cast<double>(points);
+  r.details["feature_size"] = options.featureSize;
+  r.details["points"] = points;
+  r.details["cells"] = mesh.cells.size();
+  return r;
+}
+
 nlohmann::json ToJson(const Result& r)
 {
   nlohmann::json j;
@@ -437,8 +514,8 @@ bool Selected(const std::string& name)
 CLI::App* AddBenchCommand(CLI::App& app)
 {
   CLI::App* bench = app.add_subcommand("bench",
-    "Time the performance workloads (prospero rendering, csg3 sampling against VTK); see "
-    "docs/performance.md");
+    "Time the performance workloads (prospero rendering, csg3 sampling against VTK, sphereGyroid "
+    "meshing, the flower complex); see docs/performance.md");
   bench->add_flag("--json", Options.Json, "Print a JSON array, one object per workload");
   bench->add_option("--models", Options.Models,
     "Folder of Fidget's .vm models (default: $ICTK_BENCH_MODELS, else the build's default)");
@@ -499,6 +576,18 @@ int RunBenchCommand()
   if (Selected("csg3-" + std::to_string(sampleSize)))
   {
     report(Csg3(sampleSize));
+  }
+  const double gyroidSize = Options.Quick ? 0.1 : 0.025;
+  std::ostringstream gyroidName;
+  gyroidName << "sphere-gyroid-" << gyroidSize;
+  if (Selected(gyroidName.str()))
+  {
+    report(SphereGyroid(gyroidSize));
+  }
+  const int flowerDivisions = Options.Quick ? 64 : 256;
+  if (Selected("flower-" + std::to_string(flowerDivisions)))
+  {
+    report(Flower(flowerDivisions));
   }
   if (results.empty() && !Options.Only.empty())
   {

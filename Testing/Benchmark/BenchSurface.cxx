@@ -8,9 +8,9 @@
 //   ictkBenchSurface --benchmark_filter=0.025         (any Google Benchmark flag)
 //   ICTK_BENCH_THREADS=1 ictkBenchSurface             another thread count
 #include "Discretize/Surface.h"
+#include "FRep/BundledModels.h"
 #include "FRep/Field.h"
 #include "FRep/Tape.h"
-#include "SurfaceTestShapes.h"
 
 #include <benchmark/benchmark.h>
 
@@ -29,7 +29,8 @@ int threads()
 
 void sphereGyroid(benchmark::State& state, double featureSize)
 {
-  const frep::FieldPtr field = frep::tapeField(frep::Tape::compile(surfacetest::sphereGyroid()));
+  const frep::FieldPtr field =
+    frep::tapeField(frep::Tape::compile(frep::bundled::sphereGyroidField()));
   const frep::Box3 box{ { -5, -5, -5 }, { 5, 5, 5 } };
   discretize::SurfaceOptions options;
   options.featureSize = featureSize;

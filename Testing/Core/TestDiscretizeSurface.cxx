@@ -3,11 +3,11 @@
 // topology, determinism, cancellation and argument checks. The CGAL self-intersection check is in
 // TestDiscretizeSurfaceCgal.cxx (CGAL adds -frounding-math to its executable).
 #include "Discretize/Surface.h"
+#include "FRep/BundledModels.h"
 #include "FRep/Field.h"
 #include "FRep/Primitives.h"
 #include "FRep/Sampling.h"
 #include "FRep/Tape.h"
-#include "SurfaceTestShapes.h"
 
 #include <gtest/gtest.h>
 
@@ -488,7 +488,7 @@ TEST(DiscretizeSurface, NestedShells)
 // closed manifold, whatever the resolution.
 TEST(DiscretizeSurface, GyroidIsManifold)
 {
-  const Expr sg = surfacetest::sphereGyroid();
+  const Expr sg = frep::bundled::sphereGyroidField();
   for (double h : { 0.1, 0.17, 0.31 })
   {
     const SurfaceMesh mesh = contour(sg, { { -5, -5, -5 }, { 5, 5, 5 } }, h);
@@ -503,7 +503,7 @@ TEST(DiscretizeSurface, GyroidIsManifold)
 
 TEST(DiscretizeSurface, IdenticalForAnyThreadCount)
 {
-  const Expr sg = surfacetest::sphereGyroid();
+  const Expr sg = frep::bundled::sphereGyroidField();
   const Box3 box{ { -5, -5, -5 }, { 5, 5, 5 } };
   const SurfaceMesh one = contour(sg, box, 0.1, 1);
   const SurfaceMesh two = contour(sg, box, 0.1, 2);
@@ -517,7 +517,7 @@ TEST(DiscretizeSurface, IdenticalForAnyThreadCount)
 
 TEST(DiscretizeSurface, ProgressAndCancellation)
 {
-  const auto field = fieldOf(surfacetest::sphereGyroid());
+  const auto field = fieldOf(frep::bundled::sphereGyroidField());
   const Box3 box{ { -5, -5, -5 }, { 5, 5, 5 } };
   SurfaceOptions options;
   options.featureSize = 0.1;

@@ -3,10 +3,10 @@
 // benchmark at coarse sizes is a valid, closed, outward-oriented mesh without self-intersections
 // (exact predicates). Its own executable: CGAL adds -frounding-math to whatever links it.
 #include "Discretize/Surface.h"
+#include "FRep/BundledModels.h"
 #include "FRep/Field.h"
 #include "FRep/Primitives.h"
 #include "FRep/Tape.h"
-#include "SurfaceTestShapes.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
@@ -61,7 +61,8 @@ void expectClean(const discretize::SurfaceMesh& mesh)
 
 TEST(DiscretizeSurfaceCgal, SphereGyroidHasNoSelfIntersections)
 {
-  const frep::FieldPtr field = frep::tapeField(frep::Tape::compile(surfacetest::sphereGyroid()));
+  const frep::FieldPtr field =
+    frep::tapeField(frep::Tape::compile(frep::bundled::sphereGyroidField()));
   for (double h : { 0.1, 0.17, 0.2, 0.25, 0.31 })
   {
     SCOPED_TRACE(h);

@@ -496,3 +496,17 @@ TEST(BundledModels, MorphDependsOnTime)
   EXPECT_NEAR(value(hv, 0.9, 0, 0, 0.5), 0.0, 1e-12);
   EXPECT_NEAR(value(hv, 0.9, 0, 0, 1.0), -0.1, 1e-12);
 }
+
+// --- sphere_gyroid
+// -------------------------------------------------------------------------------------
+
+TEST(SphereGyroid, HandValues)
+{
+  // At the origin g = 0, gyroid = max(0, -0.5) = 0, sphere = -3, sg = 0 and
+  // min(sg, 2 sqrt(|sg|) - 0.5) = -0.5: f = 0.5. At (4, 0, 0) g = sin(8), sphere = 1, sg = 1,
+  // 2 sqrt(1) - 0.5 = 1.5: f = -1.
+  PointEvaluator e(Tape::compile(bundled::sphereGyroidField()));
+  EXPECT_DOUBLE_EQ(e.eval(0, 0, 0), 0.5);
+  EXPECT_DOUBLE_EQ(e.eval(4, 0, 0), -1.0);
+  EXPECT_EQ(findModel("sphere_gyroid").boundsHi[0], 5.0);
+}

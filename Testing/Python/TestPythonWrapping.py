@@ -2,8 +2,10 @@
 import math
 import sys
 
+import os
+
 import vtk
-from ictk import ictkFiltersFRep
+from ictk import ictkFiltersComplex, ictkFiltersFRep
 
 
 def check(condition, message):
@@ -57,4 +59,19 @@ area.SetInputConnection(clip.GetOutputPort())
 area.Update()
 # The z = 0 section of the unit sphere is the unit disk.
 check(abs(area.GetSurfaceArea() - math.pi) < 0.005 * math.pi, f"clipped area {area.GetSurfaceArea()}")
+# The flower complex as a partitioned dataset collection: 12 cells, 4/3/2/3 by dimension in the
+# assembly, a colour on every point.
+source = ictkFiltersComplex.ictkComplexSource()
+source.SetFileName(os.environ["ICTK_FLOWER"])
+source.SetFeatureSize(0.04)
+source.Update()
+collection = source.GetOutput()
+check(collection.GetNumberOfPartitionedDataSets() == 12, "flower: 12 cells")
+assembly = collection.GetDataAssembly()
+per_dimension = [assembly.GetNumberOfChildren(assembly.GetFirstNodeByPath(f"/flower/dimension_{p}"))
+                 for p in range(4)]
+check(per_dimension == [4, 3, 2, 3], f"flower: cells per dimension {per_dimension}")
+for i in range(12):
+    leaf = collection.GetPartitionedDataSet(i).GetPartition(0)
+    check(leaf.GetPointData().GetArray("colour") is not None, f"flower: colour on cell {i}")
 print("python wrapping: all checks passed")

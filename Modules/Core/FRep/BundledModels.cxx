@@ -353,6 +353,17 @@ CsgRecipe random1000Recipe()
   return r;
 }
 
+Expr sphereGyroidField()
+{
+  const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
+  const double s = 0.5;
+  const Expr g = sin(x / s) * cos(y / s) + sin(y / s) * cos(z / s) + sin(z / s) * cos(x / s);
+  const Expr gyroid = max(g, g - 0.5);
+  const Expr sphere = sqrt(x * x + y * y + z * z) - 3.0;
+  const Expr sg = max(sphere, gyroid);
+  return -min(sg, min(sg, 2.0 * sqrt(abs(sg)) - 0.5));
+}
+
 std::vector<ModelInfo> modelInfos()
 {
   std::vector<ModelInfo> models;
@@ -384,6 +395,10 @@ std::vector<ModelInfo> modelInfos()
   models.push_back(info("morph",
     "space-time (XYZT) metamorphosis from a unit ball (t <= 0) to the box [-0.8,0.8]^3 (t >= 1)",
     -1.2, 1.2, morph));
+  models.push_back(info("sphere_gyroid",
+    "libfive's mesh benchmark sphereGyroid: a gyroid shell clipped by a sphere of radius 3, "
+    "negated to f >= 0 inside",
+    -5, 5, [] { return Hypervolume(Shape(sphereGyroidField(), Domain::XYZ, "sphere_gyroid")); }));
   return models;
 }
 

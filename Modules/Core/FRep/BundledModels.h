@@ -56,6 +56,12 @@ Expr csgField(const CsgRecipe& recipe);
 Expr vtkBoxField(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
 
 /// Every bundled model (the registry starts with these).
+/// libfive's mesh benchmark "sphereGyroid" (libfive test/util/shapes.cpp; the formulas of
+/// shared/bench/README.md), negated to FRep's convention (f >= 0 inside):
+///   g = sin(x/s)cos(y/s) + sin(y/s)cos(z/s) + sin(z/s)cos(x/s), s = 0.5; gyroid = max(g, g - 0.5)
+///   sphere = |p| - 3; sg = max(sphere, gyroid); f = -min(sg, min(sg, 2 sqrt(|sg|) - 0.5)).
+Expr sphereGyroidField();
+
 std::vector<ModelInfo> modelInfos();
 
 } // namespace ictk::frep::bundled
