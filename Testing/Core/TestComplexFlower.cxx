@@ -362,3 +362,43 @@ TEST(Attachment, ComplexAttachmentQuotientsSharedCells)
   EXPECT_THROW(attachComplex(k, l2, { { x, ab } }), ComplexError);
   EXPECT_EQ(k.cellCount(), 5u);
 }
+
+TEST(ComplexFile, CompositeAndComputedCells)
+{
+  // Two unit balls 1.2 apart: their union (C), their intersection lens (C), and the circle where
+  // their boundaries meet (T): x = 0.6, y^2 + z^2 = 1 - 0.36 = 0.64, radius 0.8.
+  const Complex k = lang::readComplexJson(R"({
+  "cells": [
+    { "name": "a", "kind": "F", "dimension": 3, "inside": ["1 - x[1]^2 - x[2]^2 - x[3]^2"],
+      "bounds": [[-1, -1, -1], [1, 1, 1]] },
+    { "name": "b", "kind": "F", "dimension": 3,
+      "inside": ["1 - (x[1] - 1.2)^2 - x[2]^2 - x[3]^2"], "bounds": [[0.2, -1, -1], [2.2, 1, 1]] },
+    { "name": "both", "kind": "C", "dimension": 3, "operation": "union", "operands": ["a", "b"] },
+    { "name": "lens", "kind": "C", "dimension": 3, "operation": "intersection",
+      "operands": ["a", "b"] },
+    { "name": "rim", "kind": "T", "dimension": 1, "boundary_of": ["a", "b"] }
+  ],
+  "relations": { "boundary": [["lens", "rim"]], "containment": [["both", "lens"]] }
+})",
+    "two-balls.json");
+  DiscretizationOptions o;
+  o.featureSize = 0.04;
+  const ComplexMesh mesh = discretizeComplex(k, o);
+  // The union's volume: two balls minus the lens, 2 (4/3 pi) - 2 pi h^2 (3 - h) / 3, h = 0.4.
+  const double lens = 2 * M_PI * 0.4 * 0.4 * (3 - 0.4) / 3;
+  EXPECT_NEAR(discretize::enclosedVolume(mesh.of(k.idOf("both")).surface),
+    2 * 4.0 / 3.0 * M_PI - lens, 0.01 * (8.0 / 3.0 * M_PI));
+  EXPECT_NEAR(discretize::enclosedVolume(mesh.of(k.idOf("lens")).surface), lens, 0.02 * lens);
+  const CellMesh& rim = mesh.of(k.idOf("rim"));
+  ASSERT_EQ(rim.curves.lines.size(), 1u);
+  for (const Point3& p : rim.curves.points)
+  {
+    EXPECT_NEAR(p[0], 0.6, 1e-8);
+    EXPECT_NEAR(std::hypot(p[1], p[2]), 0.8, 1e-8);
+  }
+  const ValidationReport report = validateComplex(k, mesh);
+  EXPECT_TRUE(report.ok()) << report.text(k);
+  EXPECT_EQ(report.satisfied.size(), 2u);
+  // The rim also bounds both balls and the union contains both balls: found, not declared.
+  EXPECT_GE(report.undeclared.size(), 2u) << report.text(k);
+}
