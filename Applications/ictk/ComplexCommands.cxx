@@ -293,6 +293,7 @@ int RunComplexMesh(const ComplexOptions& o)
   source->SetComplex(k);
   source->SetFeatureSize(o.FeatureSize);
   source->SetNumberOfThreads(o.Threads);
+  source->SetVolumeResolution(o.VolumeResolution);
   // The source reports failures as VTK errors; keep the message for our own error line.
   std::string failure;
   vtkNew<vtkCallbackCommand> onError;

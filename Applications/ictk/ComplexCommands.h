@@ -14,6 +14,7 @@ struct ComplexOptions
   bool Json = false;
   double FeatureSize = 0;
   double Tolerance = 0;
+  int VolumeResolution = 0;
   int Threads = 0;
 };
 

@@ -1104,6 +1104,9 @@ int Run(int argc, char** argv)
     ->required();
   mesh->add_option("--feature-size", meshFeatureSize,
     "Complexes: mesh edge length and curve step (default: 1/64 of the complex's size)");
+  int meshVolumeResolution = 0;
+  mesh->add_option("--volume-resolution", meshVolumeResolution,
+    "Complexes: also sample each implicit 3D cell's field on N^3 points (vtkImageData)");
 
   ictk::cli::ComplexOptions infoOptions;
   CLI::App* info = app.add_subcommand(
@@ -1173,6 +1176,7 @@ int Run(int argc, char** argv)
       o.Model = meshOptions.Model;
       o.Output = meshOptions.Output;
       o.FeatureSize = meshFeatureSize;
+      o.VolumeResolution = meshVolumeResolution;
       o.Threads = meshOptions.Threads;
       return ictk::cli::RunComplexMesh(o);
     }

@@ -164,6 +164,7 @@ TEST(ComplexVTK, VoxelAndMeshCellsFromFiles)
   vtkNew<ictkComplexSource> source;
   source->SetFileName(files.path("scene.json").c_str());
   source->SetFeatureSize(h);
+  source->SetVolumeResolution(17);
   source->Update();
   vtkPartitionedDataSetCollection* pdc = source->GetOutput();
   ASSERT_EQ(pdc->GetNumberOfPartitionedDataSets(), 3u);
@@ -173,6 +174,22 @@ TEST(ComplexVTK, VoxelAndMeshCellsFromFiles)
   auto* kind = vtkStringArray::SafeDownCast(scanData->GetFieldData()->GetAbstractArray("CellKind"));
   ASSERT_NE(kind, nullptr);
   EXPECT_EQ(kind->GetValue(0), "V");
+  // The optional volume of the FRep implicant: 17^3 samples of 0.25 - |p|^2 over [-0.5, 0.5]^3.
+  vtkPartitionedDataSet* implant = nullptr;
+  for (unsigned int i = 0; i < pdc->GetNumberOfPartitionedDataSets(); ++i)
+  {
+    if (vtkPolyData::SafeDownCast(pdc->GetPartitionedDataSet(i)->GetPartition(0)) ==
+      partition(pdc, "implant"))
+    {
+      implant = pdc->GetPartitionedDataSet(i);
+    }
+  }
+  ASSERT_NE(implant, nullptr);
+  auto* volume = vtkImageData::SafeDownCast(implant->GetPartition(1));
+  ASSERT_NE(volume, nullptr);
+  EXPECT_EQ(volume->GetNumberOfPoints(), 17 * 17 * 17);
+  // The centre sample (8, 8, 8) is at the origin: f = 0.25.
+  EXPECT_NEAR(volume->GetPointData()->GetArray("f")->GetTuple1((8 * 17 + 8) * 17 + 8), 0.25, 1e-6);
 }
 
 TEST(ComplexVTK, UnreadableFilesNameTheCellAndFile)

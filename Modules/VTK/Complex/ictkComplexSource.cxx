@@ -11,6 +11,7 @@
 #include "vtkDataAssembly.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
+#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkIntArray.h"
@@ -275,6 +276,25 @@ std::shared_ptr<voxel::VoxelGrid> readVolume(const std::string& path, const std:
   return grid;
 }
 
+/// A cell's solid field sampled on an image over its bounds.
+vtkSmartPointer<vtkImageData> sampleVolume(const complex::ImplicitGeometry& g, int resolution)
+{
+  const frep::FieldPtr field = g.inside.size() == 1 ? g.inside[0] : frep::minField(g.inside);
+  const voxel::VoxelGrid grid =
+    voxel::sampleToGrid(*field, g.bounds, { resolution, resolution, resolution });
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(static_cast<int>(grid.dimensions[0]), static_cast<int>(grid.dimensions[1]),
+    static_cast<int>(grid.dimensions[2]));
+  image->SetOrigin(grid.origin.data());
+  image->SetSpacing(grid.spacing.data());
+  auto f = vtkSmartPointer<vtkFloatArray>::New();
+  f->SetName("f");
+  f->SetNumberOfTuples(static_cast<vtkIdType>(grid.values.size()));
+  std::copy(grid.values.begin(), grid.values.end(), f->GetPointer(0));
+  image->GetPointData()->SetScalars(f);
+  return image;
+}
+
 template <typename T, typename V>
 void addField(vtkFieldData* fd, const char* name, V value)
 {
@@ -308,7 +328,7 @@ complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path)
 }
 
 void ictkComplexSource::Convert(const complex::Complex& k, const complex::ComplexMesh& mesh,
-  vtkPartitionedDataSetCollection* output)
+  vtkPartitionedDataSetCollection* output, int volumeResolution)
 {
   output->Initialize();
   auto assembly = vtkSmartPointer<vtkDataAssembly>::New();
@@ -328,6 +348,11 @@ void ictkComplexSource::Convert(const complex::Complex& k, const complex::Comple
     auto part = vtkSmartPointer<vtkPartitionedDataSet>::New();
     vtkSmartPointer<vtkPolyData> leaf = toPolyData(m);
     part->SetPartition(0, leaf);
+    const auto* implicit = std::get_if<complex::ImplicitGeometry>(&c.geometry);
+    if (volumeResolution > 1 && c.dimension == 3 && implicit)
+    {
+      part->SetPartition(1, sampleVolume(*implicit, volumeResolution));
+    }
     output->SetPartitionedDataSet(next, part);
     output->GetMetaData(next)->Set(vtkCompositeDataSet::NAME(), c.name.c_str());
     vtkFieldData* fd = part->GetFieldData();
@@ -433,7 +458,7 @@ int ictkComplexSource::RequestData(
       return !this->GetAbortExecute();
     };
     const complex::ComplexMesh mesh = complex::discretizeComplex(*k, options);
-    Convert(*k, mesh, output);
+    Convert(*k, mesh, output, this->VolumeResolution);
     return 1;
   }
   catch (const frep::Cancelled&)
@@ -454,5 +479,6 @@ void ictkComplexSource::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << this->FileName << "\n";
   os << indent << "FeatureSize: " << this->FeatureSize << "\n";
+  os << indent << "VolumeResolution: " << this->VolumeResolution << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
 }

@@ -9,6 +9,9 @@
  * patches, boundary surfaces of solids) at FeatureSize, and becomes one partitioned dataset
  * holding a vtkPolyData whose point data carries every attribute of the complex.
  *
+ * With VolumeResolution > 0, the partitioned dataset of every implicit 3D cell also holds the
+ * cell's field sampled on a vtkImageData (array "f").
+ *
  * Each partitioned dataset's field data holds CellId, CellName, CellKind, CellDimension and
  * CellDescription. The collection's vtkDataAssembly has the nodes
  *   /dimension_0 .. /dimension_3: the cells by dimension;
@@ -58,6 +61,11 @@ public:
   vtkSetClampMacro(FeatureSize, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(FeatureSize, double);
 
+  /// When > 0, every implicit 3D cell also gets a vtkImageData of its field f (f >= 0 inside)
+  /// sampled at this many points per axis over its bounds, as partition 1 of its dataset.
+  vtkSetClampMacro(VolumeResolution, int, 0, 2048);
+  vtkGetMacro(VolumeResolution, int);
+
   /// Threads for the discretisers; 0 = TBB's default. Results do not depend on it.
   vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
   vtkGetMacro(NumberOfThreads, int);
@@ -75,7 +83,7 @@ public:
   void SetComplex(std::shared_ptr<const ictk::complex::Complex> complex);
   /// The VTK form of a discretised complex.
   static void Convert(const ictk::complex::Complex& complex, const ictk::complex::ComplexMesh& mesh,
-    vtkPartitionedDataSetCollection* output);
+    vtkPartitionedDataSetCollection* output, int volumeResolution = 0);
 #endif
 
 protected:
@@ -86,6 +94,7 @@ protected:
 
   std::string FileName;
   double FeatureSize = 0;
+  int VolumeResolution = 0;
   int NumberOfThreads = 0;
 
 private:
