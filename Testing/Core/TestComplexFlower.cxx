@@ -402,3 +402,37 @@ TEST(ComplexFile, CompositeAndComputedCells)
   // The rim also bounds both balls and the union contains both balls: found, not declared.
   EXPECT_GE(report.undeclared.size(), 2u) << report.text(k);
 }
+
+TEST(ComplexFile, EmptyCellsAreErrors)
+{
+  // An FRep cell with no inside point, and the boundary curve of two balls that do not meet
+  // (their boxes overlap, the spheres do not): both are named, not silently dropped.
+  const Complex k = lang::readComplexJson(R"({
+  "cells": [
+    { "name": "nothing", "kind": "F", "dimension": 3, "inside": ["-1 - x[1]^2"],
+      "bounds": [[-1, -1, -1], [1, 1, 1]] },
+    { "name": "a", "kind": "F", "dimension": 3, "inside": ["1 - x[1]^2 - x[2]^2 - x[3]^2"],
+      "bounds": [[-1, -1, -1], [1, 1, 1]] },
+    { "name": "b", "kind": "F", "dimension": 3,
+      "inside": ["1 - (x[1] - 1.9)^2 - (x[2] - 1.9)^2 - x[3]^2"], "bounds": [[0.9, 0.9, -1], [2.9, 2.9, 1]] },
+    { "name": "meet", "kind": "T", "dimension": 1, "boundary_of": ["a", "b"] }
+  ]
+})",
+    "empty.json");
+  DiscretizationOptions o;
+  o.featureSize = 0.05;
+  for (const char* name : { "nothing", "meet" })
+  {
+    try
+    {
+      discretizeCell(k, k.idOf(name), o);
+      FAIL() << name;
+    }
+    catch (const ComplexError& e)
+    {
+      EXPECT_THAT(e.what(), HasSubstr("cell '" + std::string(name) + "'"));
+      EXPECT_THAT(e.what(), HasSubstr("is empty"));
+    }
+  }
+  EXPECT_NO_THROW(discretizeCell(k, k.idOf("a"), o));
+}

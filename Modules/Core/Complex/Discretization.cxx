@@ -283,9 +283,22 @@ CellMesh discretizeCell(const Complex& complex, CellId id, const DiscretizationO
   {
     throw;
   }
+  catch (const ComplexError&)
+  {
+    throw;
+  }
   catch (const std::exception& e)
   {
     throw ComplexError("cell '" + c.name + "' cannot be discretised: " + e.what());
+  }
+  if (out.vertices().empty())
+  {
+    // An empty cell is a modelling error (seed 001 L93: every cell must be discretisable).
+    throw ComplexError("cell '" + c.name + "' (" + kindCode(c.kind) + ", " +
+      std::to_string(c.dimension) +
+      "D) is empty: no point of its bounds satisfies its carriers and inside fields at feature "
+      "size " +
+      std::to_string(o.featureSize));
   }
   for (const auto& binding : c.attributes)
   {
