@@ -131,7 +131,24 @@ void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::st
   const fs::path targetPieces = target.parent_path() / target.stem();
   if (fs::exists(pieces))
   {
-    fs::remove_all(targetPieces);
+    // Replace an earlier pieces folder only when it holds nothing but pieces of this file.
+    if (fs::exists(targetPieces))
+    {
+      const std::string prefix = target.stem().string() + "_";
+      for (const auto& entry : fs::directory_iterator(targetPieces))
+      {
+        const std::string name = entry.path().filename().string();
+        if (!entry.is_regular_file() || name.rfind(prefix, 0) != 0 ||
+          entry.path().extension().string().rfind(".vt", 0) != 0)
+        {
+          fs::remove_all(staging);
+          throw std::runtime_error("cannot write '" + output + "': the folder '" +
+            targetPieces.string() + "' holds other files ('" + name +
+            "'); move them or choose another name");
+        }
+      }
+      fs::remove_all(targetPieces);
+    }
     fs::rename(pieces, targetPieces);
   }
   fs::rename(stagedFile, target);

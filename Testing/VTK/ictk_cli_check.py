@@ -325,6 +325,17 @@ def check_complex_flower(ictk, work, data):
     counts = [blocks.GetBlock(p).GetNumberOfBlocks() for p in range(4)]
     if counts != [4, 3, 2, 3]:
         sys.exit(f"FAIL: .vtm blocks per dimension {counts}")
+    # Writing again replaces the pieces; a same-named folder holding other files is left alone.
+    run(ictk, ["mesh", model, "-o", vtpc, "--feature-size", "0.03"])
+    mine = os.path.join(work, "mine")
+    os.makedirs(mine)
+    with open(os.path.join(mine, "notes.txt"), "w") as f:
+        f.write("keep me")
+    p = run(ictk, ["mesh", model, "-o", os.path.join(work, "mine.vtpc"), "--feature-size", "0.03"], check=False)
+    if p.returncode != 2 or "holds other files" not in p.stderr or not os.path.exists(os.path.join(mine, "notes.txt")):
+        sys.exit(f"FAIL: a folder of the user's was not protected: exit {p.returncode}, {p.stderr!r}")
+    if os.path.exists(os.path.join(work, "mine.vtpc")):
+        sys.exit("FAIL: mine.vtpc was written although its pieces could not be")
     # A bad relation: exit 2, a diagnostic with file, line and column, nothing written.
     bad = os.path.join(work, "bad.json")
     with open(bad, "w") as f:
