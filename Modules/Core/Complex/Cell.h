@@ -109,6 +109,9 @@ struct Cell
   std::string description;
   CellKind kind = CellKind::FRep;
   int dimension = 3;
+  /// Where 3D cells overlap, the region belongs to the cell of highest priority (material
+  /// assignment for meshing); overlapping cells of equal priority are an error there.
+  double priority = 0;
   CellGeometry geometry;
   /// Cells a composite (C) or computed (T) cell is built from.
   std::vector<CellId> operands;

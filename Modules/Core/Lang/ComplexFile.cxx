@@ -405,6 +405,7 @@ private:
       c.description = spec.value("description", std::string());
       current_ = locate("name", c.name);
       const std::string where = "cell '" + c.name + "'";
+      c.priority = number(spec, "priority", 0.0, where + ": \"priority\"");
       try
       {
         c.kind = complex::kindFromCode(spec.value("kind", std::string("F")));
