@@ -14,11 +14,13 @@
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationObjectBaseKey.h"
 #include "vtkIntArray.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMetaImageReader.h"
 #include "vtkMultiBlockDataSet.h"
 #include "vtkNIFTIImageReader.h"
+#include "vtkNew.h"
 #include "vtkNrrdReader.h"
 #include "vtkOBJReader.h"
 #include "vtkObjectFactory.h"
@@ -43,6 +45,34 @@
 #include <map>
 
 vtkStandardNewMacro(ictkComplexSource);
+vtkInformationKeyMacro(ictkComplexSource, COMPLEX, ObjectBase);
+
+namespace
+{
+/// Holds the complex in a vtkObject, the form information keys carry.
+class ictkComplexHolder : public vtkObject
+{
+public:
+  static ictkComplexHolder* New();
+  vtkTypeMacro(ictkComplexHolder, vtkObject);
+  std::shared_ptr<const ictk::complex::Complex> Complex;
+
+protected:
+  ictkComplexHolder() = default;
+  ~ictkComplexHolder() override = default;
+};
+vtkStandardNewMacro(ictkComplexHolder);
+} // namespace
+
+std::shared_ptr<const ictk::complex::Complex> ictkComplexSource::GetComplex(vtkDataObject* data)
+{
+  if (!data)
+  {
+    return nullptr;
+  }
+  auto* holder = ictkComplexHolder::SafeDownCast(data->GetInformation()->Get(COMPLEX()));
+  return holder ? holder->Complex : nullptr;
+}
 
 namespace
 {
@@ -459,6 +489,9 @@ int ictkComplexSource::RequestData(
     };
     const complex::ComplexMesh mesh = complex::discretizeComplex(*k, options);
     Convert(*k, mesh, output, this->VolumeResolution);
+    vtkNew<ictkComplexHolder> holder;
+    holder->Complex = k;
+    output->GetInformation()->Set(COMPLEX(), holder);
     return 1;
   }
   catch (const frep::Cancelled&)

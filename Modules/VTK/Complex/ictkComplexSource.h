@@ -32,6 +32,8 @@
 #include <memory> // for std::shared_ptr
 #include <string> // for std::string
 
+class vtkDataObject;
+class vtkInformationObjectBaseKey;
 class vtkMultiBlockDataSet;
 class vtkPartitionedDataSetCollection;
 
@@ -70,6 +72,10 @@ public:
   vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
   vtkGetMacro(NumberOfThreads, int);
 
+  /// Set on the output's information: the complex itself, so that downstream filters
+  /// (ictkTetrahedralize) can use its fields, not only its discretisation.
+  static vtkInformationObjectBaseKey* COMPLEX();
+
   /// The cells as a vtkMultiBlockDataSet (blocks per dimension, then one per cell, named), for
   /// consumers that do not read partitioned dataset collections (.vtm files).
   static void ToMultiBlock(vtkPartitionedDataSetCollection* input, vtkMultiBlockDataSet* output);
@@ -79,6 +85,8 @@ public:
   /// .vtu, .stl, .ply, .obj; voxel cells from .vti, .mha/.mhd, .nii/.nii.gz, .nrrd/.nhdr (and
   /// .vdb through the core). Throws ictk::lang::ParseError.
   static ictk::complex::Complex ReadComplexFile(const std::string& path);
+  /// The complex a dataset made by this source carries (COMPLEX()), or nullptr.
+  static std::shared_ptr<const ictk::complex::Complex> GetComplex(vtkDataObject* data);
   /// A complex built in C++; used instead of FileName when set.
   void SetComplex(std::shared_ptr<const ictk::complex::Complex> complex);
   /// The VTK form of a discretised complex.
