@@ -4,6 +4,7 @@
 // is certainly negative is outside, so the union of the other sub-boxes holds the solid.
 
 #include "FRep/Evaluators.h"
+#include "FRep/Field.h"
 
 #include <array>
 #include <optional>
@@ -11,11 +12,8 @@
 namespace ictk::frep
 {
 
-struct Box
-{
-  std::array<double, 3> lo;
-  std::array<double, 3> hi;
-};
+/// The boxes of Field.h (one box type for the kernel).
+using Box = Box3;
 
 /// A box inside `search` that contains every point of `search` where f may be >= 0 (at time
 /// `time`), refined by `depth` octree subdivisions; nullopt when the model is certainly empty
