@@ -1,0 +1,282 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Events (thesis L1327-1333), reactions and the stepper with TIME_REJECTED (§4.4.2 L2061-2082),
+// and locating transitions in time (root finding). Hand-derived values in the comments.
+
+#include "Dynamics/Events.h"
+#include "Dynamics/RootFinding.h"
+#include "Dynamics/Stepper.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace ictk::dyn;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+TEST(DynamicsEvents, QueueOrderIsTimePriorityNameInsertion)
+{
+  EventQueue q;
+  q.push(Event::at("b", 1.0, 1.0));
+  q.push(Event::at("z", 1.0, 2.0));
+  q.push(Event::at("early", 0.5, 0.0));
+  q.push(Event::at("a", 1.0, 1.0, { { "k", 1.0 } }));
+  q.push(Event::at("a", 1.0, 1.0, { { "k", 2.0 } }));
+  q.push(Event::at("later", 2.0, 9.0));
+  // t = 0.5 first; at t = 1 the higher priority z (L1333); then a before b by name; the two a's
+  // in insertion order. "later" (t = 2) is not due at t = 1.
+  std::vector<std::string> order;
+  std::vector<double> ks;
+  for (const Event& e : q.popUntil(1.0))
+  {
+    order.push_back(e.name);
+    if (e.name == "a")
+      ks.push_back(e.parameters.at("k"));
+  }
+  EXPECT_THAT(order, ElementsAre("early", "z", "a", "a", "b"));
+  EXPECT_THAT(ks, ElementsAre(1.0, 2.0));
+  ASSERT_EQ(q.size(), 1u);
+  EXPECT_EQ(q.top().name, "later");
+}
+
+TEST(DynamicsEvents, ReactionsReceiveEventsAndFireNewOnes)
+{
+  // R1 reacts to HIT (priority 2) and LOW (priority 1), both fired for t = 0.25 (ch4 feature 66:
+  // HIT first), records HIT's parameter and fires ECHO; R2 reacts to ECHO in the same frame
+  // (feature 67). An event for t = 2 stays queued.
+  ParameterTable p;
+  p.add("R1", "seen", Scope::Global, 0.0);
+  p.add("R2", "echoes", Scope::Global, 0.0);
+  Stepper s(p);
+  Reaction r1;
+  r1.name = "R1";
+  r1.reactsTo = { "HIT", "LOW" };
+  r1.react = [](StepContext& c, const Event& e)
+  {
+    if (e.name == "HIT")
+    {
+      c.set("R1.seen", e.parameters.at("force"));
+      c.fireEvent(Event{ "ECHO", {}, {}, 1.0 });
+    }
+  };
+  Reaction r2;
+  r2.name = "R2";
+  r2.reactsTo = { "ECHO" };
+  r2.react = [](StepContext& c, const Event&)
+  {
+    c.set("R2.echoes", c.get("R2.echoes") + 1);
+  };
+  s.addReaction(r1);
+  s.addReaction(r2);
+  s.fireEvent(Event::at("LOW", 0.25, 1.0));
+  s.fireEvent(Event::at("HIT", 0.25, 2.0, { { "force", 7.5 } }));
+  s.fireEvent(Event::at("HIT", 2.0, 2.0, { { "force", 1.0 } }));
+  s.step(0.5);
+  EXPECT_EQ(s.params().value("R1.seen"), 7.5);
+  EXPECT_EQ(s.params().value("R2.echoes"), 1.0);
+  std::vector<std::string> names;
+  for (const Event& e : s.processedEvents())
+    names.push_back(e.name);
+  // ECHO was fired at t = 0.5 (the frame's time), after HIT and LOW at 0.25.
+  EXPECT_THAT(names, ElementsAre("HIT", "LOW", "ECHO"));
+  std::vector<std::string> reacts;
+  for (const std::string& l : s.log())
+    if (l.find(".react:") != std::string::npos)
+      reacts.push_back(l);
+  EXPECT_THAT(reacts, ElementsAre("R1.react:HIT", "R1.react:LOW", "R2.react:ECHO"));
+}
+
+TEST(DynamicsEvents, InitAndTerminateFollowTheLifeSpan)
+{
+  // A reaction alive on [0.5, 1.5] (ch4 feature 34): init at the first frame inside, terminate at
+  // the first frame after; no update outside. Frames at 0.25, 0.5, ..., 2.
+  ParameterTable p;
+  p.add("C", "updates", Scope::Global, 0.0);
+  p.add("C", "lifeAtInit", Scope::Global, -1.0);
+  Stepper s(p);
+  Reaction r;
+  r.name = "C";
+  r.life = TimeSpan::interval(0.5, 1.5);
+  r.init = [](StepContext& c)
+  {
+    c.set("C.lifeAtInit", c.lifeT);
+  };
+  r.update = [](StepContext& c)
+  {
+    c.set("C.updates", c.get("C.updates") + 1);
+  };
+  s.addReaction(r);
+  for (int i = 0; i < 8; ++i)
+    s.step(0.25);
+  // Alive at 0.5, 0.75, 1.0, 1.25, 1.5: five updates; life time 0 at activation.
+  EXPECT_EQ(s.params().value("C.updates"), 5.0);
+  EXPECT_EQ(s.params().value("C.lifeAtInit"), 0.0);
+  EXPECT_EQ(std::count(s.log().begin(), s.log().end(), "C.init"), 1);
+  EXPECT_EQ(std::count(s.log().begin(), s.log().end(), "C.terminate"), 1);
+}
+
+namespace
+{
+// A reaction that accepts steps of at most 0.3 (like STB_CELL, L3136-3164) and counts its
+// updates in the state, so that a rejected attempt must not leave a trace (ch4 feature 68).
+Stepper limited(double requestedStep)
+{
+  ParameterTable p;
+  p.add("Guard", "count", Scope::Global, 0.0);
+  Stepper s(p);
+  Reaction r;
+  r.name = "Guard";
+  r.update = [requestedStep](StepContext& c)
+  {
+    c.set("Guard.count", c.get("Guard.count") + 1);
+    if (c.dt > 0.3)
+      c.rejectTime(requestedStep);
+  };
+  s.addReaction(r);
+  return s;
+}
+} // namespace
+
+TEST(DynamicsEvents, TimeRejectedHalvesTheStepAndRestoresTheState)
+{
+  // step(1): h = 1 rejected, 0.5 rejected, 0.25 accepted; then 0.25 steps up to exactly 1
+  // (fig. 56b: the requested time is still delivered). Frames at 0.25, 0.5, 0.75, 1: count = 4
+  // (the two rejected attempts were rolled back, otherwise it would be 6).
+  Stepper s = limited(std::nan(""));
+  EXPECT_EQ(s.step(1.0), 4);
+  EXPECT_THAT(s.acceptedTimes(), ElementsAre(0.25, 0.5, 0.75, 1.0));
+  EXPECT_EQ(s.rejections(), 2);
+  EXPECT_EQ(s.time(), 1.0);
+  EXPECT_EQ(s.params().value("Guard.count"), 4.0);
+}
+
+TEST(DynamicsEvents, TimeRejectedWithARequestedStep)
+{
+  // IC::fireEvent(TIME_REJECTED, 0.2) (L2075): retried with h = 0.2: frames at 0.2, 0.4, 0.6,
+  // 0.8 and exactly 1.0 (the last sub-step lands on the target), one rejection.
+  Stepper s = limited(0.2);
+  EXPECT_EQ(s.step(1.0), 5);
+  ASSERT_EQ(s.acceptedTimes().size(), 5u);
+  EXPECT_NEAR(s.acceptedTimes()[2], 0.6, 1e-15);
+  EXPECT_EQ(s.acceptedTimes().back(), 1.0);
+  EXPECT_EQ(s.rejections(), 1);
+  EXPECT_EQ(s.params().value("Guard.count"), 5.0);
+}
+
+TEST(DynamicsEvents, TimeRejectedLimits)
+{
+  // A step back before the last correctly evaluated time makes the model invalid (L2082).
+  Stepper back = limited(-0.1);
+  try
+  {
+    back.step(1.0);
+    FAIL();
+  }
+  catch (const ModelError& e)
+  {
+    EXPECT_THAT(e.what(), HasSubstr("L2082"));
+  }
+  // A reaction that never accepts: bounded by maxHalvings.
+  ParameterTable p;
+  Stepper never(p);
+  Reaction r;
+  r.name = "Never";
+  r.update = [](StepContext& c)
+  {
+    c.fireEvent(Event{ events::TimeRejected, {}, {}, 1.0 });
+  };
+  never.addReaction(r);
+  StepperOptions o;
+  o.maxHalvings = 5;
+  never.setOptions(o);
+  EXPECT_THROW(never.step(1.0), StepRejectedError);
+  EXPECT_EQ(never.rejections(), 6);
+  EXPECT_EQ(never.time(), 0.0); // nothing accepted, state at the last valid time
+}
+
+TEST(DynamicsRootFinding, SignChangeIsRefined)
+{
+  // g(t) = 3 - t on [2.5, 3.7]: one secant step from the bracketing samples lands on 3.
+  auto c = locateCrossing([](double t) { return 3.0 - t; }, 2.5, 3.7);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->kind, Crossing::Kind::SignChange);
+  EXPECT_NEAR(c->time, 3.0, 1e-12);
+  // g(t) = t^3 - 2 on [1, 2]: the root is 2^(1/3) = 1.2599210498948732.
+  auto d = locateCrossing([](double t) { return t * t * t - 2.0; }, 1.0, 2.0);
+  ASSERT_TRUE(d);
+  EXPECT_NEAR(d->time, std::cbrt(2.0), 1e-12);
+  // The earliest of two roots: (t - 1.2)(t - 1.7) on [1, 2] -> 1.2.
+  auto e = locateCrossing([](double t) { return (t - 1.2) * (t - 1.7); }, 1.0, 2.0);
+  ASSERT_TRUE(e);
+  EXPECT_NEAR(e->time, 1.2, 1e-12);
+  EXPECT_FALSE(locateCrossing([](double t) { return t + 1.0; }, 0.0, 1.0));
+}
+
+TEST(DynamicsRootFinding, InstantaneousTouchIsFound)
+{
+  // A unit disk passing a rectangle's corner (0,0) along x + y = sqrt(2) at speed sqrt(2):
+  // centre c(t) = (sqrt(2)/2 + s, sqrt(2)/2 - s), s = t - 2.5. While the corner is the nearest
+  // rectangle point, the gap is g = |c| - 1 = sqrt(1 + 2 s^2) - 1 >= 0, zero only at s = 0: a
+  // tangency at t = 2.5 without a sign change. Both ends of the step [2, 3.1] are positive
+  // (g(2) = sqrt(1.5) - 1 = 0.22, g(3.1) = sqrt(1.72) - 1 = 0.31), so a two-sample test misses it.
+  auto g = [](double t)
+  {
+    const double s = t - 2.5;
+    return std::sqrt(1.0 + 2.0 * s * s) - 1.0;
+  };
+  ASSERT_GT(g(2.0), 0.2);
+  ASSERT_GT(g(3.1), 0.3);
+  auto c = locateCrossing(g, 2.0, 3.1);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->kind, Crossing::Kind::Touch);
+  // g ~ s^2 is flat below rounding within ~1e-8 of the touch; the parabola-vertex correction
+  // (RootFinding.h) recovers the time of this symmetric touch to rounding.
+  EXPECT_NEAR(c->time, 2.5, 1e-9);
+  EXPECT_LE(std::abs(c->value), 1e-9);
+  // An asymmetric touch, g = 2 s^2 + s^3 with s = t - 1.7 on [1, 2.3] (8 samples, spacing
+  // 0.1625). The vertex of the parabola through s = -h, 0, +h (h = 1e-4 * 2 * 0.1625 = 3.25e-5)
+  // is at -h (gr - gl) / (2 (gl - 2 g0 + gr)) = -h (2 h^3) / (2 * 4 h^2) = -h^2 / 4 = -2.6e-10:
+  // the cubic term biases the touch time by 2.6e-10.
+  auto a = locateCrossing(
+    [](double t)
+    {
+      const double s = t - 1.7;
+      return s * s * (2.0 + s);
+    },
+    1.0, 2.3);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->kind, Crossing::Kind::Touch);
+  EXPECT_NEAR(a->time, 1.7 - 3.25e-5 * 3.25e-5 / 4.0, 1e-11);
+  // Passing at distance 1.1 instead (min g = 0.1): no touch.
+  EXPECT_FALSE(locateCrossing([&](double t) { return g(t) + 0.1; }, 2.0, 3.1));
+}
+
+TEST(DynamicsRootFinding, StepperStopsAtTheCrossing)
+{
+  // The disk of thesis 5.1 moves by a time reaction (L1345): x = -2 + 0.5 t; radius 0.75; the
+  // rectangle's left side is x = 0.25. Gap g = 0.25 - (x + 0.75) = 1.5 - 0.5 t: zero at t = 3.
+  ParameterTable p;
+  p.add("LHKF", "x", Scope::Global, -2.0);
+  Stepper s(p, 2.8);
+  Reaction r;
+  r.name = "LHKF";
+  r.update = [](StepContext& c)
+  {
+    c.set("LHKF.x", -2.0 + 0.5 * c.globalT);
+  };
+  s.addReaction(r);
+  auto gap = [](const ParameterTable& q, double)
+  {
+    return 0.25 - (q.value("LHKF.x") + 0.75);
+  };
+  auto c = s.stepUntil(0.4, gap);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->time, 3.0, 1e-9);
+  EXPECT_EQ(s.time(), c->time); // the state is delivered at the transition
+  EXPECT_NEAR(s.params().value("LHKF.x"), -0.5, 1e-9);
+  // The next step has no crossing and ends at 3.4.
+  EXPECT_FALSE(s.stepUntil(0.4 - (c->time - 2.8), gap));
+  EXPECT_NEAR(s.time(), 3.2, 1e-12);
+}
