@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// Two-material bars for the mesh tests (issue 6): [0,1]x[0,0.2]^2 and [1,2]x[0,0.2]^2 as a
+// complex read from JSON, meshed by the Kuhn split of a box grid and labelled by centroids.
+
+#include "Lang/ComplexFile.h"
+#include "Mesh/Attributes.h"
+#include "Mesh/Structured.h"
+
+#include <string>
+
+namespace ictk::testing
+{
+
+/// The solver check's bar: E = 210000 | 70000, nu = 0 (springs in series are then exact).
+inline std::string barJson(const std::string& left = "steel",
+  const std::string& right = "aluminium", const std::string& leftModulus = "210000",
+  bool spare = false)
+{
+  std::string s = R"({ "name": "bar",
+  "attributes": {
+    "youngs_modulus": { "components": 1, "inside": [1] },
+    "poisson_ratio": { "components": 1, "inside": [0] },
+    "density": { "components": 1, "inside": [1e-9] }
+  },
+  "attribute_functions": {
+    "E1": [")" +
+    leftModulus + R"("], "E2": ["70000"], "NU": ["0"], "RHO": ["7.8e-9"]
+  },
+  "cells": [
+    { "name": ")" +
+    left + R"(", "kind": "F", "dimension": 3,
+      "inside": ["x[1]", "1 - x[1]", "x[2]", "0.2 - x[2]", "x[3]", "0.2 - x[3]"],
+      "bounds": [[0, 0, 0], [1, 0.2, 0.2]],
+      "attributes": { "youngs_modulus": "E1", "poisson_ratio": "NU", "density": "RHO" } },
+    { "name": ")" +
+    right + R"(", "kind": "F", "dimension": 3,
+      "inside": ["x[1] - 1", "2 - x[1]", "x[2]", "0.2 - x[2]", "x[3]", "0.2 - x[3]"],
+      "bounds": [[1, 0, 0], [2, 0.2, 0.2]],
+      "attributes": { "youngs_modulus": "E2", "poisson_ratio": "NU" } })";
+  if (spare)
+  {
+    s += R"(,
+    { "name": "spare", "kind": "F", "dimension": 3,
+      "inside": ["1 - (x[1] - 5)^2 - x[2]^2 - x[3]^2"], "bounds": [[4, -1, -1], [6, 1, 1]],
+      "attributes": { "youngs_modulus": "E2" } })";
+  }
+  return s + "\n  ]\n}\n";
+}
+
+/// The bar meshed with `nx` blocks along x and `ny` across, attributes assigned.
+inline mesh::TetMesh barMesh(const complex::Complex& k, int nx = 20, int ny = 2)
+{
+  mesh::TetMesh m = mesh::kuhnTetMesh({ { 0, 0, 0 }, { 2, 0.2, 0.2 } }, { nx, ny, ny });
+  mesh::labelByCentroid(m, k);
+  mesh::assignAttributes(m, k);
+  return m;
+}
+
+} // namespace ictk::testing
