@@ -14,6 +14,7 @@
 //   flower-256            the discretisation of every cell of Data/Models/flower/flower.json at
 //                         1/256 of its size (surfaces, patches, traced curves, points)
 #include "Bench.h"
+#include "BenchScaling.h"
 
 #include "Complex/Discretization.h"
 #include "Discretize/Surface.h"
@@ -21,6 +22,9 @@
 #include "FRep/ModelRegistry.h"
 #include "FRep/Render.h"
 #include "FRep/Sampling.h"
+#ifdef ICTK_HAVE_JIT
+#include "FRep/Jit.h"
+#endif
 #include "Lang/ComplexFile.h"
 #include "Lang/VmReader.h"
 
@@ -165,16 +169,25 @@ frep::TapePtr ProsperoTape(std::string& whyNot)
   return frep::Tape::compile(lang::readVmFile(file.string()).function);
 }
 
-Result Prospero(const frep::TapePtr& tape, bool prune, int size)
+Result Prospero(const frep::TapePtr& tape, bool prune, int size, bool jit = false)
 {
   Result r;
   r.workload = std::string("prospero-") + (prune ? "pruned-" : "brute-") + std::to_string(size);
+  frep::RenderOptions options;
+#ifdef ICTK_HAVE_JIT
+  if (jit) // the same render with pixels evaluated by the JIT (FRep/Jit.h)
+  {
+    r.workload += "-jit";
+    options.rowEvaluator = frep::jitRowEvaluatorFactory();
+  }
+#else
+  (void)jit;
+#endif
   r.what = prune ? "sign of prospero.vm, recursive interval subdivision (tiles 128, 32), float"
                  : "sign of prospero.vm, every pixel with the full tape, float";
   r.threads = ThreadsOr(prune ? 2 : 1);
   r.work = static_cast<double>(size) * size;
   r.unit = "Mpixel/s";
-  frep::RenderOptions options;
   options.prune = prune;
   options.threads = r.threads;
   std::vector<std::uint8_t> image;
@@ -527,6 +540,7 @@ CLI::App* AddBenchCommand(CLI::App& app)
     "--only", Options.Only, "Run the workloads whose name contains one of these (comma-separated)");
   bench->add_flag(
     "--quick", Options.Quick, "Small sizes (prospero 128^2, csg3 64^3), one run: a smoke test");
+  AddScalingOptions(*bench); // --scaling (BenchScaling.cxx)
   return bench;
 }
 
@@ -535,6 +549,10 @@ int RunBenchCommand()
   if (Options.Threads < 0)
   {
     throw std::invalid_argument("--threads must be at least 0");
+  }
+  if (ScalingRequested())
+  {
+    return RunScalingBench(Options.Runs, Options.Threads, Options.Json, Options.Quick);
   }
   if (Options.Quick)
   {
@@ -553,7 +571,7 @@ int RunBenchCommand()
   };
   const std::string brute = "prospero-brute-" + std::to_string(renderSize);
   const std::string pruned = "prospero-pruned-" + std::to_string(renderSize);
-  if (Selected(brute) || Selected(pruned))
+  if (Selected(brute) || Selected(pruned) || Selected(brute + "-jit") || Selected(pruned + "-jit"))
   {
     std::string whyNot;
     const frep::TapePtr tape = ProsperoTape(whyNot);
@@ -571,6 +589,15 @@ int RunBenchCommand()
       {
         report(Prospero(tape, true, renderSize));
       }
+#ifdef ICTK_HAVE_JIT
+      for (const bool prune : { false, true })
+      {
+        if (frep::JitEvaluator::available() && Selected((prune ? pruned : brute) + "-jit"))
+        {
+          report(Prospero(tape, prune, renderSize, true));
+        }
+      }
+#endif
     }
   }
   if (Selected("csg3-" + std::to_string(sampleSize)))

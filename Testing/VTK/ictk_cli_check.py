@@ -4,6 +4,7 @@
 
 Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d | bench
+  | bench-scaling
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
 "@WORK@" in ICTK-ARGS is replaced by the work folder.
 """
@@ -371,6 +372,23 @@ def check_bench(ictk, work):
         sys.exit(f"FAIL: --only without a match: exit {p.returncode}\n{p.stderr}")
 
 
+def check_bench_scaling(ictk, work):
+    # `ictk bench --scaling --quick` (BenchScaling.cxx): the tables' shape and the counters, not
+    # the timings.
+    d = json.loads(run(ictk, ["bench", "--scaling", "--quick", "--json"]).stdout)
+    for key in ("models", "size_sampling", "size_render2d", "size_contour", "resolution_sampling",
+                "resolution_occupancy3d", "resolution_render2d", "resolution_contour"):
+        if not isinstance(d.get(key), list) or len(d[key]) != 2:
+            sys.exit(f"FAIL: {key} should list 2 rows: {d.get(key)}")
+    if [m["tape_instructions"] for m in d["models"]] != [99, 1016]:
+        sys.exit(f"FAIL: randomCsgRecipe(6 / 62) tape sizes: {d['models']}")
+    for row in d["resolution_sampling"]:
+        if not 0 < row["pruned_instruction_evaluations"] <= row["full_instruction_evaluations"]:
+            sys.exit(f"FAIL: pruned sampling counters: {row}")
+    if "| r | voxels (r^3) |" not in run(ictk, ["bench", "--scaling", "--quick"]).stdout:
+        sys.exit("FAIL: plain scaling report")
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -389,6 +407,7 @@ def main():
         "mesh-formats": check_mesh_formats,
         "model-files": check_model_files,
         "bench": check_bench,
+        "bench-scaling": check_bench_scaling,
     }
     if check == "complex-flower":
         check_complex_flower(ictk, work, rest[0])

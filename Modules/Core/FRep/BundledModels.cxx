@@ -317,11 +317,20 @@ CsgRecipe csg3Recipe()
 
 CsgRecipe random1000Recipe()
 {
-  PortableRandom rng(RandomSeed);
+  return randomCsgRecipe(RandomPrimitiveCount, RandomSeed);
+}
+
+CsgRecipe randomCsgRecipe(int primitives, std::uint32_t seed)
+{
+  if (primitives < 1)
+  {
+    throw std::invalid_argument("randomCsgRecipe: at least one primitive is needed");
+  }
+  PortableRandom rng(seed);
   CsgRecipe r;
   std::array<double, 3> c{ 0, 0, 0 };
   std::vector<int> leaves;
-  for (int i = 0; i < RandomPrimitiveCount; ++i)
+  for (int i = 0; i < primitives; ++i)
   {
     // One draw per statement: the order of evaluation of function arguments is unspecified.
     for (double& v : c)
@@ -349,7 +358,7 @@ CsgRecipe random1000Recipe()
     }
     leaves.push_back(addNode(r, n));
   }
-  r.root = combine(r, rng, leaves, 0, RandomPrimitiveCount);
+  r.root = combine(r, rng, leaves, 0, primitives);
   return r;
 }
 

@@ -45,6 +45,12 @@ CsgRecipe csg3Recipe();
 CsgRecipe sphereRecipe();
 /// The random CSG of spheres and boxes behind `random1000` (fixed seed, portable).
 CsgRecipe random1000Recipe();
+/// The same family with `primitives` spheres and boxes (at least 1) and any seed: a random walk
+/// of centres in [-0.75, 0.75]^3, combined by a balanced tree of min/max (13 to 16 tape
+/// instructions per primitive: 62 give 1016, 628 give 10019, 7940 give 100161). random1000Recipe()
+/// is randomCsgRecipe(48, 20240611). Used by the scaling benchmark (`ictk bench --scaling`,
+/// docs/performance.md).
+CsgRecipe randomCsgRecipe(int primitives, std::uint32_t seed);
 
 /// The ICTK field (f >= 0 inside) of a recipe: exactly minus the field of the equivalent
 /// vtkImplicitBoolean tree, operation for operation (up to the rounding of vtkCylinder's

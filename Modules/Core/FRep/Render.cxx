@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace ictk::frep
 {
@@ -91,6 +92,14 @@ public:
         {
           subdivide(ws, 0, tape_, ws.interval, box);
         }
+        else if (useFast())
+        {
+          if (!ws.fast)
+          {
+            ws.fast = options_.rowEvaluator(tape_, options_.parameters);
+          }
+          evaluate(ws, *ws.fast, box);
+        }
         else
         {
           evaluate(ws, ws.full, box);
@@ -135,6 +144,7 @@ private:
     }
     std::vector<double> parameters;
     BatchEvaluator<T> full;
+    std::unique_ptr<RowEvaluator> fast; // options.rowEvaluator's evaluator of the full tape
     IntervalEvaluator interval;
     std::vector<T> row;
     Counts counts;
@@ -201,6 +211,11 @@ private:
       }
       return;
     }
+    if (useFast())
+    {
+      evaluate(ws, *options_.rowEvaluator(pruned, ws.parameters), box);
+      return;
+    }
     if (pruned == tape_)
     {
       evaluate(ws, ws.full, box);
@@ -210,7 +225,10 @@ private:
     evaluate(ws, leaf, box);
   }
 
-  void evaluate(Workspace& ws, BatchEvaluator<T>& evaluator, const Box& box)
+  bool useFast() const { return std::is_same_v<T, float> && options_.rowEvaluator; }
+
+  template <typename Evaluator>
+  void evaluate(Workspace& ws, Evaluator& evaluator, const Box& box)
   {
     const auto& d = layout_.dims;
     const std::size_t n = static_cast<std::size_t>(box.hi[0] - box.lo[0]);
@@ -223,8 +241,19 @@ private:
       for (std::int64_t j = box.lo[1]; j < box.hi[1]; ++j)
       {
         const double y = layout_.coordinate(1, j);
-        evaluator.evalRowX(
-          layout_.origin[0], layout_.spacing[0], box.lo[0], y, z, layout_.time, ws.row.data(), n);
+        if constexpr (std::is_same_v<Evaluator, RowEvaluator>)
+        {
+          if constexpr (std::is_same_v<T, float>) // only float renders use it (useFast())
+          {
+            evaluator.evalRowX(layout_.origin[0], layout_.spacing[0], box.lo[0], y, z, layout_.time,
+              ws.row.data(), n);
+          }
+        }
+        else
+        {
+          evaluator.evalRowX(
+            layout_.origin[0], layout_.spacing[0], box.lo[0], y, z, layout_.time, ws.row.data(), n);
+        }
         std::uint8_t* p = image_ + (k * d[1] + j) * d[0] + box.lo[0];
         const T* v = ws.row.data();
         for (std::size_t i = 0; i < n; ++i)

@@ -10,6 +10,8 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 namespace ictk::frep
@@ -23,6 +25,19 @@ struct RenderStats
   std::int64_t leafInstructions = 0; ///< sum over evaluated leaf tiles of their tape length
   std::int64_t pixelsEvaluated = 0;
 };
+
+/// A float evaluator of grid rows other than BatchEvaluator<float> (the JIT, FRep/Jit.h): what the
+/// renderer asks of it. It must give the values BatchEvaluator<float>::evalRowX gives.
+class RowEvaluator
+{
+public:
+  virtual ~RowEvaluator() = default;
+  virtual void evalRowX(double x0, double dx, std::int64_t first, double y, double z, double t,
+    float* out, std::size_t n) = 0;
+  virtual const TapePtr& tape() const = 0;
+};
+using RowEvaluatorFactory = std::function<std::unique_ptr<RowEvaluator>(
+  const TapePtr& tape, const std::vector<double>& parameters)>;
 
 struct RenderOptions
 {
@@ -41,6 +56,9 @@ struct RenderOptions
   /// except where a pixel's value is within float rounding of 0 or of a pruned min/max tie.
   bool singlePrecision = true;
   std::vector<double> parameters;
+  /// When set (and singlePrecision), pixels are evaluated by evaluators it makes instead of
+  /// BatchEvaluator<float>, e.g. frep::jitRowEvaluatorFactory() (FRep/Jit.h).
+  RowEvaluatorFactory rowEvaluator;
   /// When set, receives the counts of the render.
   RenderStats* stats = nullptr;
 };

@@ -159,6 +159,7 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
   tbb::enumerable_thread_specific<std::optional<Workspace<T>>> workspaces;
   std::atomic<std::int64_t> done{ 0 };
   std::atomic<bool> cancelled{ false };
+  std::atomic<std::int64_t> statPoints{ 0 }, statInstructions{ 0 };
   const std::thread::id caller = std::this_thread::get_id();
   std::int64_t lastReported = -1;
   const std::int64_t reportEvery = std::max<std::int64_t>(1, brickCount / 100);
@@ -189,6 +190,13 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
       region.axes[3] = { grid.time, grid.time };
       ws.interval.eval(region);
       evaluator = &ws.evaluatorFor(ws.interval.choices());
+    }
+    if (options.stats)
+    {
+      const std::int64_t points = (i1 - i0) * (j1 - j0) * (k1 - k0);
+      statPoints += points;
+      statInstructions +=
+        points * static_cast<std::int64_t>(evaluator->tape()->instructions().size());
     }
     for (std::int64_t k = k0; k < k1; ++k)
     {
@@ -235,6 +243,12 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
   else
   {
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body);
+  }
+  if (options.stats)
+  {
+    options.stats->bricks = brickCount;
+    options.stats->pointsEvaluated = statPoints;
+    options.stats->instructionEvaluations = statInstructions;
   }
   if (cancelled)
   {

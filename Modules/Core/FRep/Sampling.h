@@ -45,6 +45,16 @@ public:
   }
 };
 
+/// Counts of what a sampling did (for benchmarks: `ictk bench --scaling`).
+struct SampleStats
+{
+  std::int64_t bricks = 0;
+  std::int64_t pointsEvaluated = 0;
+  /// Sum over the bricks of points x the length of the tape they were evaluated with (the pruned
+  /// tape when pruning): instruction evaluations, before row hoisting.
+  std::int64_t instructionEvaluations = 0;
+};
+
 struct SampleOptions
 {
   /// Threads to use; 0 = TBB's default.
@@ -56,6 +66,8 @@ struct SampleOptions
   /// Called with the completed fraction; return false to cancel (sampleGrid then throws Cancelled).
   std::function<bool(double)> progress;
   std::vector<double> parameters;
+  /// When set, receives the counts of the sampling.
+  SampleStats* stats = nullptr;
 };
 
 /// Fills `out` (grid.pointCount() values) with the tape's first output.

@@ -1,0 +1,379 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Mesh/TetGen/MeshTetGen.h"
+
+#include "FRep/Expr.h"
+#include "FRep/Sampling.h"
+#include "FRep/Tape.h"
+
+#include <tetgen.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <new>
+#include <sstream>
+#include <stdexcept>
+#include <variant>
+
+namespace ictk::mesh
+{
+namespace
+{
+
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::time_point since)
+{
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+std::string number(double v)
+{
+  char text[64];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+std::string point(const Point3& p)
+{
+  return "(" + number(p[0]) + ", " + number(p[1]) + ", " + number(p[2]) + ")";
+}
+
+/// The box [lo, hi] as a field (min of six half-spaces).
+frep::FieldPtr boundsField(const frep::Box3& b)
+{
+  using frep::Expr;
+  auto c = [](double v)
+  {
+    return Expr::constant(v);
+  };
+  const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
+  const Expr f = min(min(min(x - c(b.lo[0]), c(b.hi[0]) - x), min(y - c(b.lo[1]), c(b.hi[1]) - y)),
+    min(z - c(b.lo[2]), c(b.hi[2]) - z));
+  return frep::tapeField(frep::Tape::compile(f));
+}
+
+std::string tetgenError(int code)
+{
+  switch (code)
+  {
+    case 1:
+      return "out of memory";
+    case 2:
+      return "internal error";
+    case 3:
+      return "the input surfaces intersect each other (self-intersection)";
+    case 4:
+      return "a very small input feature was found (input points or edges too close for its "
+             "tolerance)";
+    case 5:
+      return "two very close input facets were found";
+    case 10:
+      return "invalid input";
+    default:
+      return "unknown error";
+  }
+}
+
+bool finiteBox(const frep::Box3& b)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(b.lo[a]) || !std::isfinite(b.hi[a]) || !(b.lo[a] < b.hi[a]))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+double orient(const std::vector<Point3>& p, const std::array<std::uint32_t, 4>& t)
+{
+  const Point3& a = p[t[0]];
+  double e[3][3];
+  for (int k = 0; k < 3; ++k)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      e[k][c] = p[t[k + 1]][c] - a[c];
+    }
+  }
+  return e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+    e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+    e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+}
+
+void checkSize(const TetraOptions& o)
+{
+  if (!(o.size > 0) || !std::isfinite(o.size))
+  {
+    throw std::invalid_argument("TetGen backend: the mesh size must be a positive number");
+  }
+}
+
+double labelledVolume(const discretize::MaterialSurface& s, int materials)
+{
+  double volume = 0;
+  for (int m = 1; m <= materials; ++m)
+  {
+    volume += discretize::materialVolume(s, m);
+  }
+  return volume;
+}
+
+void checkBudget(double estimate, const TetraOptions& o)
+{
+  if (estimate > o.maxTetrahedra)
+  {
+    throw std::invalid_argument("TetGen backend: size " + number(o.size) + " gives about " +
+      number(estimate) + " tetrahedra, more than the limit of " + number(o.maxTetrahedra) +
+      " (raise maxTetrahedra or the size)");
+  }
+}
+
+} // namespace
+
+TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, int materials,
+  const TetraOptions& o, TetGenReport* report)
+{
+  checkSize(o);
+  if (surface.triangles.empty())
+  {
+    throw std::invalid_argument("TetGen backend: the surface is empty (no cell has volume)");
+  }
+  const double estimate = estimateTetrahedra(labelledVolume(surface, materials), o.size);
+  checkBudget(estimate, o);
+
+  tetgenio in, out;
+  in.firstnumber = 0;
+  in.numberofpoints = static_cast<int>(surface.points.size());
+  in.pointlist = new REAL[surface.points.size() * 3];
+  for (std::size_t i = 0; i < surface.points.size(); ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      in.pointlist[3 * i + std::size_t(c)] = surface.points[i][std::size_t(c)];
+    }
+  }
+  in.numberoffacets = static_cast<int>(surface.triangles.size());
+  in.facetlist = new tetgenio::facet[surface.triangles.size()];
+  in.facetmarkerlist = new int[surface.triangles.size()];
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t)
+  {
+    tetgenio::facet& f = in.facetlist[t];
+    tetgenio::init(&f);
+    f.numberofpolygons = 1;
+    f.polygonlist = new tetgenio::polygon[1];
+    tetgenio::init(&f.polygonlist[0]);
+    f.polygonlist[0].numberofvertices = 3;
+    f.polygonlist[0].vertexlist = new int[3];
+    for (int c = 0; c < 3; ++c)
+    {
+      f.polygonlist[0].vertexlist[c] = static_cast<int>(surface.triangles[t][std::size_t(c)]);
+    }
+    // The pair of labels, for TetGen's boundary markers.
+    in.facetmarkerlist[t] = surface.labels[t][0] * (materials + 1) + surface.labels[t][1];
+  }
+  int regions = 0, holes = 0;
+  for (const auto& r : surface.regions)
+  {
+    (r.label == 0 ? holes : regions) += 1;
+  }
+  in.numberofregions = regions;
+  in.regionlist = regions ? new REAL[std::size_t(regions) * 5] : nullptr;
+  in.numberofholes = holes;
+  in.holelist = holes ? new REAL[std::size_t(holes) * 3] : nullptr;
+  int ri = 0, hi = 0;
+  for (const auto& r : surface.regions)
+  {
+    if (r.label == 0)
+    {
+      std::copy(r.point.begin(), r.point.end(), in.holelist + 3 * hi++);
+    }
+    else
+    {
+      REAL* e = in.regionlist + 5 * ri++;
+      std::copy(r.point.begin(), r.point.end(), e);
+      e[3] = r.label;
+      e[4] = -1; // no regional volume bound: the global one applies
+    }
+  }
+
+  // -Y keeps the conforming surface as it is (TetGen's quality refinement would otherwise split
+  // the small marching-tetrahedra triangles again and again: 5-10 times the tetrahedra); the
+  // volume bound is 3 regular tetrahedra of edge `size`, since refinement ends well below it.
+  const double maxVolume = 3 * o.size * o.size * o.size / (6 * std::sqrt(2.0));
+  std::ostringstream sw;
+  sw.precision(6);
+  sw << "pYq1.414/" << o.minDihedralDegrees << "a" << maxVolume << "AQ";
+  std::string switches = sw.str();
+  if (report)
+  {
+    report->switches = switches;
+    report->estimate = estimate;
+    report->surfacePoints = surface.points.size();
+    report->surfaceTriangles = surface.triangles.size();
+  }
+  if (o.progress && !o.progress(0.35))
+  {
+    throw frep::Cancelled();
+  }
+  const auto start = Clock::now();
+  try
+  {
+    tetrahedralize(switches.data(), &in, &out);
+  }
+  catch (int code)
+  {
+    throw std::runtime_error("TetGen failed (error " + std::to_string(code) + ": " +
+      tetgenError(code) + ") on a surface of " + std::to_string(surface.points.size()) +
+      " points and " + std::to_string(surface.triangles.size()) + " triangles with switches -" +
+      switches);
+  }
+  if (report)
+  {
+    report->tetgenSeconds = seconds(start);
+  }
+
+  TetMesh mesh;
+  const int base = out.firstnumber;
+  mesh.points.resize(std::size_t(out.numberofpoints));
+  for (int i = 0; i < out.numberofpoints; ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      mesh.points[std::size_t(i)][std::size_t(c)] = out.pointlist[3 * i + c];
+    }
+  }
+  const auto tets = std::size_t(out.numberoftetrahedra);
+  mesh.tetrahedra.resize(tets);
+  mesh.materials.resize(tets);
+  mesh.cells.resize(tets);
+  for (std::size_t t = 0; t < tets; ++t)
+  {
+    std::array<std::uint32_t, 4> tet;
+    for (std::size_t c = 0; c < 4; ++c)
+    {
+      tet[c] = static_cast<std::uint32_t>(
+        out.tetrahedronlist[t * std::size_t(out.numberofcorners) + c] - base);
+    }
+    if (orient(mesh.points, tet) < 0)
+    {
+      std::swap(tet[1], tet[2]);
+    }
+    mesh.tetrahedra[t] = tet;
+    const double attribute = out.numberoftetrahedronattributes > 0
+      ? out.tetrahedronattributelist[t * std::size_t(out.numberoftetrahedronattributes)]
+      : 0;
+    const auto m = static_cast<std::int32_t>(std::lround(attribute));
+    if (m < 1 || m > materials)
+    {
+      throw std::runtime_error("TetGen backend: tetrahedron " + std::to_string(t) +
+        " has region attribute " + number(attribute) + ", not a material");
+    }
+    mesh.materials[t] = m;
+    mesh.cells[t] = static_cast<complex::CellId>(m - 1);
+  }
+  for (int m = 1; m <= materials; ++m)
+  {
+    mesh.materialNames.push_back("material " + std::to_string(m));
+  }
+  if (o.progress && !o.progress(1.0))
+  {
+    throw frep::Cancelled();
+  }
+  return mesh;
+}
+
+TetMesh tetrahedralizeTetGen(
+  const complex::Complex& complex, const TetraOptions& o, TetGenReport* report)
+{
+  checkSize(o);
+  const std::vector<complex::CellId> ids = complex.cellsOfDimension(3);
+  if (ids.empty())
+  {
+    throw std::invalid_argument("TetGen backend: the complex has no 3D cell");
+  }
+  std::vector<frep::FieldPtr> fields;
+  std::vector<double> priorities;
+  frep::Box3 box;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+  {
+    const complex::Cell& cell = complex.cell(ids[i]);
+    const auto* g = std::get_if<complex::ImplicitGeometry>(&cell.geometry);
+    if (!g || !g->carriers.empty())
+    {
+      throw std::invalid_argument("TetGen backend: 3D cell '" + cell.name +
+        "' is not an implicit solid (only F and V cells without carriers can be meshed)");
+    }
+    if (!finiteBox(g->bounds))
+    {
+      throw std::invalid_argument(
+        "TetGen backend: 3D cell '" + cell.name + "' has no finite bounds with lo < hi");
+    }
+    std::vector<frep::FieldPtr> parts = g->inside;
+    parts.push_back(boundsField(g->bounds)); // the cell lies inside its bounds
+    fields.push_back(parts.size() == 1 ? parts[0] : frep::minField(parts));
+    priorities.push_back(cell.priority);
+    for (int a = 0; a < 3; ++a)
+    {
+      box.lo[a] = i == 0 ? g->bounds.lo[a] : std::min(box.lo[a], g->bounds.lo[a]);
+      box.hi[a] = i == 0 ? g->bounds.hi[a] : std::max(box.hi[a], g->bounds.hi[a]);
+    }
+  }
+  const int materials = static_cast<int>(ids.size());
+  discretize::MultiMaterialOptions mo;
+  mo.threads = o.threads;
+
+  // A coarse pass first, so that an absurd size is refused before the fine grid is built.
+  double side = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    side = std::max(side, box.hi[a] - box.lo[a]);
+  }
+  const double coarse = side / 24;
+  if (coarse > 2 * o.size)
+  {
+    const auto rough = discretize::multiMaterialSurface(fields, priorities, box, coarse, mo);
+    checkBudget(estimateTetrahedra(labelledVolume(rough, materials), o.size), o);
+  }
+
+  if (o.progress)
+  {
+    mo.progress = [&](double f)
+    {
+      return o.progress(0.3 * f);
+    };
+  }
+  const auto start = Clock::now();
+  const discretize::MaterialSurface surface =
+    discretize::multiMaterialSurface(fields, priorities, box, o.size, mo);
+  const double surfaceSeconds = seconds(start);
+  if (!surface.overlaps.empty())
+  {
+    const auto& v = surface.overlaps.front();
+    const complex::Cell& a = complex.cell(ids[std::size_t(v.first)]);
+    const complex::Cell& b = complex.cell(ids[std::size_t(v.second)]);
+    throw std::invalid_argument("TetGen backend: 3D cells '" + a.name + "' and '" + b.name +
+      "' overlap (both hold " + point(v.point) + ") and have the same priority " +
+      number(a.priority) + ": give one of them a higher priority");
+  }
+  TetMesh mesh = tetrahedralizeSurfaceTetGen(surface, materials, o, report);
+  if (report)
+  {
+    report->surfaceSeconds = surfaceSeconds;
+  }
+  mesh.materialNames.clear();
+  for (const auto id : ids)
+  {
+    mesh.materialNames.push_back(complex.cell(id).name);
+  }
+  for (std::size_t t = 0; t < mesh.cells.size(); ++t)
+  {
+    mesh.cells[t] = ids[std::size_t(mesh.materials[t] - 1)];
+  }
+  return mesh;
+}
+
+} // namespace ictk::mesh
