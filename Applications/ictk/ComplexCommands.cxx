@@ -41,7 +41,8 @@ bool EndsWith(std::string s, const std::string& suffix)
     s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-/// A .json complex, or a .hf / .xml model as a complex of one 3D cell.
+} // namespace
+
 complex::Complex LoadComplex(const std::string& path)
 {
   if (IsComplexInput(path))
@@ -75,6 +76,9 @@ complex::Complex LoadComplex(const std::string& path)
   k.addCell(complex::frepCell(model.name, {}, { model.model.geometry().function() }, box));
   return k;
 }
+
+namespace
+{
 
 std::string Domain(const complex::Cell& c)
 {

@@ -16,6 +16,7 @@
 #include "FRep/ModelRegistry.h"
 #include "FRep/Sampling.h"
 #include "Lang/ModelFile.h"
+#include "TetraCommand.h"
 
 #include "Bench.h"
 #include "ictkFRepSampler.h"
@@ -1108,6 +1109,9 @@ int Run(int argc, char** argv)
   mesh->add_option("--volume-resolution", meshVolumeResolution,
     "Complexes: also sample each implicit 3D cell's field on N^3 points (vtkImageData)");
 
+  ictk::cli::TetraOptions tetraOptions;
+  CLI::App* tetra = ictk::cli::AddTetraCommand(app, tetraOptions);
+
   ictk::cli::ComplexOptions infoOptions;
   CLI::App* info = app.add_subcommand(
     "info", "List the cells, relations and attributes of a complex (.json) or model");
@@ -1158,6 +1162,10 @@ int Run(int argc, char** argv)
   if (*eval)
   {
     return RunEval(evalOptions);
+  }
+  if (*tetra)
+  {
+    return ictk::cli::RunTetra(tetraOptions);
   }
   if (*info)
   {

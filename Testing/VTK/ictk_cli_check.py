@@ -389,6 +389,101 @@ def check_bench_scaling(ictk, work):
         sys.exit("FAIL: plain scaling report")
 
 
+def check_tetra_bar(ictk, work, data):
+    """ictk tetra on the two-material bar: labelled .vtu read back by VTK, .inp read by meshio,
+    and a CalculiX solve of the .inp whose tip displacement matches springs in series."""
+    model = os.path.join(data, "Models", "bar", "two_material_bar.json")
+    vtu = os.path.join(work, "bar.vtu")
+    report = json.loads(run(ictk, ["tetra", model, "-o", vtu, "--backend", "tetgen", "--size", "0.05", "--json"]).stdout)
+    if [m["name"] for m in report["materials"]] != ["steel", "alu"]:
+        sys.exit(f"FAIL: materials {report['materials']}")
+    for m in report["materials"]:
+        near(m["mesh_volume"], 0.04, 1e-9, f"mesh volume of {m['name']}")
+    import vtk
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(vtu)
+    r.Update()
+    grid = r.GetOutput()
+    if grid.GetNumberOfCells() != report["tetrahedra"]:
+        sys.exit("FAIL: .vtu tetrahedron count differs from the report")
+    material = grid.GetCellData().GetArray("MaterialId")
+    modulus = grid.GetCellData().GetArray("youngs_modulus")
+    volume = {1: 0.0, 2: 0.0}
+    for c in range(grid.GetNumberOfCells()):
+        ids = grid.GetCell(c).GetPointIds()
+        p = [grid.GetPoint(ids.GetId(k)) for k in range(4)]
+        e = [[p[k][i] - p[0][i] for i in range(3)] for k in (1, 2, 3)]
+        v = (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
+             + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6
+        m = int(material.GetTuple1(c))
+        volume[m] += v
+        expected = 210000 if m == 1 else 70000
+        if modulus.GetTuple1(c) != expected:
+            sys.exit(f"FAIL: tetrahedron {c} of material {m} has modulus {modulus.GetTuple1(c)}")
+        xs = [q[0] for q in p]
+        if (m == 1 and max(xs) > 1 + 1e-9) or (m == 2 and min(xs) < 1 - 1e-9):
+            sys.exit(f"FAIL: tetrahedron {c} of material {m} straddles x = 1")
+    near(volume[1], 0.04, 1e-9, "VTK volume of steel")
+    near(volume[2], 0.04, 1e-9, "VTK volume of alu")
+
+    inp = os.path.join(work, "bar.inp")
+    run(ictk, ["tetra", model, "-o", inp, "--backend", "tetgen", "--size", "0.05", "--deterministic"])
+    try:
+        import meshio
+        mesh = meshio.read(inp)
+        if sum(len(b.data) for b in mesh.cells if b.type == "tetra") != report["tetrahedra"]:
+            sys.exit("FAIL: meshio reads another tetrahedron count")
+    except ImportError:
+        print("meshio not installed: the .inp read-back is skipped")
+    if not shutil.which("ccx"):
+        print("ccx not installed: the CalculiX solve is skipped")
+        return
+    # The deck: the mesh (nodes, elements, materials, sections) plus supports and a pull of
+    # F = 100 as a face pressure on x = 2 (platform.md: minimal supports, *DLOAD on faces).
+    nodes, elements, section = {}, [], None
+    for line in open(inp):
+        t = line.strip()
+        if t.startswith("*"):
+            section = t.split(",")[0].upper()
+            continue
+        if not t or t.startswith("**"):
+            continue
+        f = [v.strip() for v in t.split(",")]
+        if section == "*NODE":
+            nodes[int(f[0])] = tuple(float(v) for v in f[1:4])
+        elif section == "*ELEMENT":
+            elements.append([int(v) for v in f[:5]])
+    at = lambda x: [n for n, p in nodes.items() if abs(p[0] - x) < 1e-9]
+    nearest = lambda q: min(nodes, key=lambda n: sum((nodes[n][i] - q[i]) ** 2 for i in range(3)))
+    faces = {"S1": (1, 2, 3), "S2": (1, 4, 2), "S3": (2, 4, 3), "S4": (3, 4, 1)}
+    tip = set(at(2.0))
+    loaded = [(e[0], s) for e in elements for s, f in faces.items() if all(e[k] in tip for k in f)]
+    deck = os.path.join(work, "solve.inp")
+    with open(deck, "w") as out:
+        out.write(open(inp).read())
+        out.write("*NSET, NSET=FIXX\n" + "\n".join(str(n) for n in at(0.0)) + "\n")
+        out.write("*NSET, NSET=TIP\n" + "\n".join(str(n) for n in sorted(tip)) + "\n")
+        out.write("*SURFACE, NAME=PULL, TYPE=ELEMENT\n" + "\n".join(f"{e}, {s}" for e, s in loaded) + "\n")
+        out.write(f"*BOUNDARY\nFIXX, 1, 1\n{nearest((0, 0, 0))}, 2, 3\n{nearest((0, 0.2, 0))}, 3, 3\n")
+        out.write("*STEP\n*STATIC\n*DSLOAD\nPULL, P, -2500.0\n*NODE PRINT, NSET=TIP\nU\n*END STEP\n")
+    p = subprocess.run(["ccx", "solve"], cwd=work, capture_output=True, text=True, timeout=100)
+    if "Job finished" not in p.stdout or "*ERROR" in p.stdout + p.stderr:
+        sys.exit(f"FAIL: ccx did not finish cleanly:\n{p.stdout[-2000:]}\n{p.stderr[-2000:]}")
+    ux = []
+    for line in open(os.path.join(work, "solve.dat")):
+        f = line.split()
+        if len(f) == 4 and f[0].isdigit():
+            ux.append(float(f[1]))
+    if not ux:
+        sys.exit("FAIL: no displacements in solve.dat")
+    # Springs in series: u = F L1 / (E1 A) + F L2 / (E2 A), F = 100, A = 0.04, L1 = L2 = 1.
+    expected = 100 / (210000 * 0.04) + 100 / (70000 * 0.04)
+    mean = sum(ux) / len(ux)
+    print(f"CalculiX tip displacement {mean:.6e}, springs in series {expected:.6e}, "
+          f"difference {100 * (mean - expected) / expected:+.2f}%")
+    near(mean, expected, 0.03 * expected, "tip displacement")
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -409,6 +504,10 @@ def main():
         "bench": check_bench,
         "bench-scaling": check_bench_scaling,
     }
+    if check == "tetra-bar":
+        check_tetra_bar(ictk, work, rest[0])
+        print("OK")
+        return
     if check == "complex-flower":
         check_complex_flower(ictk, work, rest[0])
         print("OK")

@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "TetraCommand.h"
+
+#include "Complex/Discretization.h"
+#include "ComplexCommands.h"
+#include "FRep/Sampling.h"
+#include "Mesh/Attributes.h"
+#include "Mesh/Quality.h"
+#include "Mesh/Writers.h"
+#include "ictkTetrahedralize.h"
+#ifdef ICTK_HAVE_MESH_CGAL
+#include "Mesh/CGAL/MeshCgal.h"
+#endif
+#ifdef ICTK_HAVE_MESH_TETGEN
+#include "Mesh/TetGen/MeshTetGen.h"
+#endif
+
+#include <vtkNew.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+namespace ictk::cli
+{
+namespace
+{
+
+bool EndsWith(std::string s, const std::string& suffix)
+{
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s.size() >= suffix.size() &&
+    s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string DefaultBackend()
+{
+#ifdef ICTK_HAVE_MESH_CGAL
+  return "cgal";
+#elif defined(ICTK_HAVE_MESH_TETGEN)
+  return "tetgen";
+#else
+  return "";
+#endif
+}
+
+/// .vtu through VTK's writer, into a temporary file renamed on success.
+void WriteVtu(const mesh::TetMesh& m, const std::string& path)
+{
+  namespace fs = std::filesystem;
+  vtkNew<vtkUnstructuredGrid> grid;
+  ictkTetrahedralize::Convert(m, grid);
+  const fs::path target = fs::absolute(path);
+  const fs::path temporary = target.parent_path() /
+    ("." + target.filename().string() + ".ictk-" + std::to_string(::getpid()) + ".vtu");
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetInputData(grid);
+  writer->SetFileName(temporary.string().c_str());
+  writer->SetDataModeToAppended();
+  if (writer->Write() != 1 || writer->GetErrorCode() != 0)
+  {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write '" + path + "'");
+  }
+  fs::rename(temporary, target);
+}
+
+} // namespace
+
+CLI::App* AddTetraCommand(CLI::App& app, TetraOptions& o)
+{
+  CLI::App* tetra = app.add_subcommand("tetra",
+    "Tetrahedral mesh of a complex for FEA (.vtu, .msh, .inp, .mesh), every tetrahedron labelled "
+    "by cell and material, with a quality report");
+  tetra->add_option("model", o.Model, "A .json complex or a .hf / .xml model")->required();
+  tetra->add_option("-o,--output", o.Output, "Output: .vtu, .msh (Gmsh 4.1), .inp, .mesh")
+    ->required();
+  tetra->add_option("--backend", o.Backend, "cgal or tetgen (default: cgal when built)");
+  tetra->add_option("--size", o.Size, "Target edge length (default: 1/32 of the complex's size)");
+  tetra->add_flag("--deterministic", o.Deterministic, "Identical output run to run");
+  tetra->add_option("--max-tets", o.MaxTetrahedra, "Refuse meshes estimated above this");
+  tetra->add_option("--threads", o.Threads, "Threads (default: all cores)");
+  tetra->add_flag("--json", o.Json, "Print the report as JSON");
+  return tetra;
+}
+
+int RunTetra(const TetraOptions& o)
+{
+  if (!(EndsWith(o.Output, ".vtu") || EndsWith(o.Output, ".msh") || EndsWith(o.Output, ".inp") ||
+        EndsWith(o.Output, ".mesh")))
+  {
+    throw std::invalid_argument("-o: '" + o.Output + "' is not a .vtu, .msh, .inp or .mesh file");
+  }
+  const std::string backend = o.Backend.empty() ? DefaultBackend() : o.Backend;
+  if (backend != "cgal" && backend != "tetgen")
+  {
+    throw std::invalid_argument("--backend must be cgal or tetgen, not '" + backend + "'");
+  }
+  if (!ictkTetrahedralize::HasBackend(
+        backend == "cgal" ? ictkTetrahedralize::CGAL : ictkTetrahedralize::TETGEN))
+  {
+    throw std::invalid_argument("the " + backend +
+      " backend was not built (configure with ICTK_ENABLE_GPL_BACKENDS=ON and its library)");
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const complex::Complex k = LoadComplex(o.Model);
+  mesh::TetraOptions options;
+  options.size = o.Size;
+  if (!(options.size > 0))
+  {
+    const frep::Box3 b = complex::complexBounds(k);
+    const double side = std::max({ b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2] });
+    options.size = side / 32;
+  }
+  options.deterministic = o.Deterministic;
+  options.maxTetrahedra = o.MaxTetrahedra;
+  options.threads = o.Threads;
+  const bool terminal = ::isatty(2) && !o.Json;
+  int lastPercent = -1;
+  options.progress = [&](double fraction)
+  {
+    const int percent = static_cast<int>(100 * fraction);
+    if (terminal && percent != lastPercent)
+    {
+      std::fprintf(stderr, "\rtetra: %3d%%", percent);
+      lastPercent = percent;
+    }
+    return true;
+  };
+  mesh::TetMesh m;
+#ifdef ICTK_HAVE_MESH_CGAL
+  if (backend == "cgal")
+  {
+    m = mesh::tetrahedralizeCgal(k, options);
+  }
+#endif
+#ifdef ICTK_HAVE_MESH_TETGEN
+  if (backend == "tetgen")
+  {
+    m = mesh::tetrahedralizeTetGen(k, options);
+  }
+#endif
+  if (terminal)
+  {
+    std::fprintf(stderr, "\n");
+  }
+  mesh::assignAttributes(m, k);
+  const double meshSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (EndsWith(o.Output, ".vtu"))
+  {
+    WriteVtu(m, o.Output);
+  }
+  else
+  {
+    mesh::writeTetMesh(m, o.Output);
+  }
+  const mesh::QualityReport q = mesh::measureQuality(m);
+  const frep::Box3 b = complex::complexBounds(k);
+  const double side = std::max({ b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2] });
+  const auto volumes = mesh::compareVolumes(m, k, std::max(options.size / 4, side / 2048));
+  if (o.Json)
+  {
+    nlohmann::json j;
+    j["output"] = o.Output;
+    j["backend"] = backend;
+    j["size"] = options.size;
+    j["seconds"] = meshSeconds;
+    j["points"] = q.points;
+    j["tetrahedra"] = q.tetrahedra;
+    j["min_dihedral_degrees"] = q.minDihedralDegrees;
+    j["min_dihedral_percentile1_degrees"] = q.minDihedralPercentile1Degrees;
+    j["max_radius_edge_ratio"] = q.maxRadiusEdgeRatio;
+    j["materials"] = nlohmann::json::array();
+    for (const auto& v : volumes)
+    {
+      j["materials"].push_back(
+        { { "material", v.material }, { "name", v.name }, { "mesh_volume", v.meshVolume },
+          { "cell_volume", v.cellVolume }, { "relative_difference", v.relativeDifference } });
+    }
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "wrote " << o.Output << " (" << q.tetrahedra << " tetrahedra, " << backend
+            << ", size " << options.size << ") in " << meshSeconds << " s\n"
+            << mesh::formatQualityReport(q) << mesh::formatVolumeComparison(volumes);
+  return 0;
+}
+
+} // namespace ictk::cli
