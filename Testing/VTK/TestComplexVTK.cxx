@@ -5,10 +5,13 @@
 
 #include "Complex/Validation.h"
 #include "ictkComplexSource.h"
+#include "ictkTetrahedralize.h"
 
+#include <vtkCellData.h>
 #include <vtkCubeSource.h>
 #include <vtkFieldData.h>
 #include <vtkFloatArray.h>
+#include <vtkIdList.h>
 #include <vtkImageData.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
@@ -18,7 +21,9 @@
 #include <vtkPolyData.h>
 #include <vtkSTLWriter.h>
 #include <vtkStringArray.h>
+#include <vtkTetra.h>
 #include <vtkTriangleFilter.h>
+#include <vtkUnstructuredGrid.h>
 #include <vtkXMLImageDataWriter.h>
 
 #include <gmock/gmock.h>
@@ -216,4 +221,62 @@ TEST(ComplexVTK, UnreadableFilesNameTheCellAndFile)
   source->SetGlobalWarningDisplay(0);
   source->Update();
   EXPECT_EQ(source->GetOutput()->GetNumberOfPartitionedDataSets(), 0u);
+}
+
+TEST(ComplexVTK, TetrahedralizeFilterLabelsEveryTetrahedron)
+{
+  if (!ictkTetrahedralize::HasBackend(ictkTetrahedralize::TETGEN))
+  {
+    GTEST_SKIP() << "the TetGen backend was not built";
+  }
+  Files files;
+  std::ofstream(files.path("bar.json")) << R"json({
+  "cells": [
+    { "name": "left", "kind": "F", "dimension": 3, "bounds": [[0, 0, 0], [1, 0.2, 0.2]],
+      "inside": ["min(min(min(x[1], 1 - x[1]), min(x[2], 0.2 - x[2])), min(x[3], 0.2 - x[3]))"]
+},
+    { "name": "right", "kind": "F", "dimension": 3, "bounds": [[1, 0, 0], [2, 0.2, 0.2]],
+      "inside": ["min(min(min(x[1] - 1, 2 - x[1]), min(x[2], 0.2 - x[2])), min(x[3], 0.2 - x[3]))"] }
+  ]
+})json";
+  vtkNew<ictkComplexSource> source;
+  source->SetFileName(files.path("bar.json").c_str());
+  source->SetFeatureSize(0.05);
+  vtkNew<ictkTetrahedralize> tetra;
+  tetra->SetInputConnection(source->GetOutputPort());
+  tetra->SetBackendToTetGen();
+  tetra->SetSize(0.05);
+  tetra->Update();
+  vtkUnstructuredGrid* grid = tetra->GetOutput();
+  ASSERT_GT(grid->GetNumberOfCells(), 100);
+  auto* material = vtkIntArray::SafeDownCast(grid->GetCellData()->GetArray("MaterialId"));
+  ASSERT_NE(material, nullptr);
+  // Both materials present, each of volume 0.04, and no tetrahedron straddles x = 1.
+  double volume[3] = { 0, 0, 0 };
+  for (vtkIdType c = 0; c < grid->GetNumberOfCells(); ++c)
+  {
+    double p[4][3];
+    vtkIdList* ids = grid->GetCell(c)->GetPointIds();
+    for (int k = 0; k < 4; ++k)
+    {
+      grid->GetPoint(ids->GetId(k), p[k]);
+    }
+    const int m = material->GetValue(c);
+    ASSERT_TRUE(m == 1 || m == 2);
+    volume[m] += vtkTetra::ComputeVolume(p[0], p[1], p[2], p[3]);
+    for (const auto& q : p)
+    {
+      EXPECT_TRUE(m == 1 ? q[0] <= 1 + 1e-9 : q[0] >= 1 - 1e-9);
+    }
+  }
+  EXPECT_NEAR(volume[1], 0.04, 1e-9);
+  EXPECT_NEAR(volume[2], 0.04, 1e-9);
+  // Without a complex on the input the filter fails with an error.
+  vtkNew<ictkTetrahedralize> orphan;
+  vtkNew<vtkPartitionedDataSetCollection> empty;
+  orphan->SetInputData(empty);
+  orphan->SetSize(0.05);
+  orphan->SetGlobalWarningDisplay(0);
+  orphan->Update();
+  EXPECT_EQ(orphan->GetOutput()->GetNumberOfCells(), 0);
 }
