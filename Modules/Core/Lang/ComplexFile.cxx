@@ -180,15 +180,17 @@ private:
         return;
       }
       const std::string path = resolve(doc["hyperfun_file"].get<std::string>());
-      std::ifstream in(path, std::ios::binary);
-      if (!in)
+      try
       {
-        report("cannot read the HyperFun library '" + path + "'", locateKey("hyperfun_file"));
+        library_ += "\n" + readSourceFile(path, limits_);
+      }
+      catch (const ParseError& e)
+      {
+        report("cannot read the HyperFun library: " + e.diagnostics()[0].where.file + ": " +
+            e.diagnostics()[0].message,
+          locateKey("hyperfun_file"));
         return;
       }
-      std::ostringstream s;
-      s << in.rdbuf();
-      library_ += "\n" + s.str();
       libraryName_ = path;
     }
   }
@@ -892,17 +894,7 @@ complex::Complex readComplexJson(const std::string& text, const std::string& fil
 complex::Complex readComplexFile(
   const std::string& path, const Limits& limits, const ComplexFileReaders& readers)
 {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-  {
-    Diagnostic d;
-    d.where.file = path;
-    d.message = "cannot open the file";
-    throw ParseError({ d });
-  }
-  std::ostringstream s;
-  s << in.rdbuf();
-  return readComplexJson(s.str(), path, limits, readers);
+  return readComplexJson(readSourceFile(path, limits), path, limits, readers);
 }
 
 } // namespace ictk::lang

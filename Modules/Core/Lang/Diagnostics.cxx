@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Lang/Diagnostics.h"
 
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+
 namespace ictk::lang
 {
 
@@ -51,6 +55,40 @@ ParseError::ParseError(std::vector<Diagnostic> diagnostics)
   : std::runtime_error(joinAll(diagnostics))
   , diagnostics_(std::move(diagnostics))
 {
+}
+
+std::string readSourceFile(const std::string& path, const Limits& limits)
+{
+  auto fail = [&](const std::string& message)
+  {
+    Diagnostic d;
+    d.where.file = path;
+    d.message = message;
+    return ParseError({ d });
+  };
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+  {
+    throw fail("cannot open the file: " + std::string(std::strerror(errno)));
+  }
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0)
+  {
+    throw fail("cannot read the file");
+  }
+  if (static_cast<std::uint64_t>(size) > limits.maxFileBytes)
+  {
+    throw fail("the file is too large: " + std::to_string(size) +
+      " bytes, more than the limit of " + std::to_string(limits.maxFileBytes));
+  }
+  in.seekg(0, std::ios::beg);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  if (size > 0 && !in.read(text.data(), size))
+  {
+    throw fail("cannot read the file");
+  }
+  return text;
 }
 
 } // namespace ictk::lang

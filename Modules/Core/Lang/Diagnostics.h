@@ -52,4 +52,8 @@ struct Limits
   std::size_t maxSyntaxNodes = 1000000;       ///< syntax tree nodes of one file (bounds memory)
 };
 
+/// The whole text of a source file; throws ParseError naming the file when it cannot be opened
+/// or read, or is larger than limits.maxFileBytes (refused before reading, so it costs no memory).
+std::string readSourceFile(const std::string& path, const Limits& limits);
+
 } // namespace ictk::lang

@@ -1157,39 +1157,6 @@ private:
     const std::string&, const std::string&, const Limits&);
 };
 
-std::string readWholeFile(const std::string& path, const Limits& limits)
-{
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-  {
-    Diagnostic d;
-    d.where.file = path;
-    d.message = "cannot open the file: " + std::string(std::strerror(errno));
-    throw ParseError({ d });
-  }
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  in.seekg(0, std::ios::beg);
-  if (size < 0 || static_cast<std::uint64_t>(size) > limits.maxFileBytes)
-  {
-    Diagnostic d;
-    d.where.file = path;
-    d.message = size < 0 ? std::string("cannot read the file")
-                         : "the file has " + std::to_string(size) +
-        " bytes, more than the limit of " + std::to_string(limits.maxFileBytes);
-    throw ParseError({ d });
-  }
-  std::string text(static_cast<std::size_t>(size), '\0');
-  if (!in.read(text.data(), size))
-  {
-    Diagnostic d;
-    d.where.file = path;
-    d.message = "cannot read the file";
-    throw ParseError({ d });
-  }
-  return text;
-}
-
 } // namespace
 
 FRepXmlDocument readFRepXmlDocument(
@@ -1233,7 +1200,7 @@ frep::Hypervolume readFRepXml(
 
 frep::Hypervolume readFRepXmlFile(const std::string& path, const Limits& limits)
 {
-  return readFRepXml(readWholeFile(path, limits), path, limits);
+  return readFRepXml(readSourceFile(path, limits), path, limits);
 }
 
 std::string writeFRepXml(const frep::Hypervolume& model, const std::string& name)

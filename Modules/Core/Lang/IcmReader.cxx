@@ -72,29 +72,7 @@ IcmModel parseIcmNotation(
 
 IcmModel readIcmFile(const std::string& path, const Limits& limits)
 {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-  {
-    throw single(path, 0, "cannot open the file");
-  }
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0)
-  {
-    throw single(path, 0, "cannot read the file");
-  }
-  if (static_cast<std::uint64_t>(size) > limits.maxFileBytes)
-  {
-    throw single(path, 0,
-      "file is too large: " + std::to_string(size) + " bytes, the limit is " +
-        std::to_string(limits.maxFileBytes));
-  }
-  in.seekg(0, std::ios::beg);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  if (size > 0 && !in.read(text.data(), size))
-  {
-    throw single(path, 0, "cannot read the file");
-  }
+  const std::string text = readSourceFile(path, limits);
   IcmModel model = readIcm(text, path, limits);
   model.directory = std::filesystem::path(path).parent_path().string();
   return model;

@@ -363,35 +363,7 @@ VmModel readVm(const std::string& text, const std::string& fileName, const Limit
 
 VmModel readVmFile(const std::string& path, const Limits& limits)
 {
-  auto fail = [&](const std::string& message)
-  {
-    Diagnostic d;
-    d.where.file = path;
-    d.message = message;
-    return ParseError({ d });
-  };
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-  {
-    throw fail("cannot open the file");
-  }
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0)
-  {
-    throw fail("cannot read the file");
-  }
-  if (static_cast<std::uint64_t>(size) > limits.maxFileBytes)
-  {
-    throw fail("file is too large: " + std::to_string(size) + " bytes, the limit is " +
-      std::to_string(limits.maxFileBytes));
-  }
-  in.seekg(0, std::ios::beg);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  if (size > 0 && !in.read(text.data(), size))
-  {
-    throw fail("cannot read the file");
-  }
+  const std::string text = readSourceFile(path, limits);
   return readVm(text, path, limits);
 }
 
