@@ -1,0 +1,904 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The CGAL Mesh_3 backend. This is the only translation unit that includes Mesh_3 (it takes about
+// a minute and 3-4 GB to compile); linking it makes the binary GPL-3.0-or-later.
+#include "Mesh/CGAL/MeshCgal.h"
+
+#include "Complex/Discretization.h"
+#include "Discretize/Curves.h"
+#include "FRep/Sampling.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Labeled_mesh_domain_3.h>
+#include <CGAL/Mesh_complex_3_in_triangulation_3.h>
+#include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_domain_with_polyline_features_3.h>
+#include <CGAL/Mesh_triangulation_3.h>
+#include <CGAL/Random.h>
+#include <CGAL/exude_mesh_3.h>
+#include <CGAL/make_mesh_3.h>
+#include <CGAL/perturb_mesh_3.h>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace ictk::mesh
+{
+namespace
+{
+
+using complex::Cell;
+using complex::CellId;
+using complex::Complex;
+using frep::Box3;
+using frep::FieldPtr;
+using Polyline = std::vector<Point3>;
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using BaseDomain = CGAL::Labeled_mesh_domain_3<K>;
+using Domain = CGAL::Mesh_domain_with_polyline_features_3<BaseDomain>;
+using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
+using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
+using Criteria = CGAL::Mesh_criteria_3<Tr>;
+
+/// Facet and cell circumradius bounds per unit of TetraOptions::size (see tetrahedralizeCgal).
+constexpr double kFacetRadius = 0.75;
+constexpr double kCellRadius = 0.8;
+
+// --- small vector helpers ---------------------------------------------------------------------
+Point3 sub(const Point3& a, const Point3& b)
+{
+  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
+}
+double dot(const Point3& a, const Point3& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+double dist(const Point3& a, const Point3& b)
+{
+  const Point3 d = sub(a, b);
+  return std::sqrt(dot(d, d));
+}
+/// The point of segment [a, b] nearest to p.
+Point3 nearestOnSegment(const Point3& p, const Point3& a, const Point3& b)
+{
+  const Point3 ab = sub(b, a);
+  const double len2 = dot(ab, ab);
+  const double t = len2 > 0 ? std::clamp(dot(sub(p, a), ab) / len2, 0.0, 1.0) : 0.0;
+  return { a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2] };
+}
+std::string pointText(const Point3& p)
+{
+  std::ostringstream s;
+  s.precision(9);
+  s << "(" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+  return s.str();
+}
+bool inBox(const Point3& p, const Box3& b)
+{
+  return p[0] >= b.lo[0] && p[0] <= b.hi[0] && p[1] >= b.lo[1] && p[1] <= b.hi[1] &&
+    p[2] >= b.lo[2] && p[2] <= b.hi[2];
+}
+Box3 padded(const Box3& b, double pad)
+{
+  return { { b.lo[0] - pad, b.lo[1] - pad, b.lo[2] - pad },
+    { b.hi[0] + pad, b.hi[1] + pad, b.hi[2] + pad } };
+}
+double diagonal(const Box3& b)
+{
+  return dist(b.lo, b.hi);
+}
+
+// --- the 3D cells as one labelled domain ------------------------------------------------------
+
+/// A 3D implicit cell: {p in box : every inside field >= 0}.
+struct Solid
+{
+  CellId id = 0;
+  std::string name;
+  double priority = 0;
+  Box3 box;
+  std::vector<FieldPtr> inside;
+};
+
+std::vector<Solid> collectSolids(const Complex& complex)
+{
+  std::vector<Solid> solids;
+  for (CellId id : complex.cellsOfDimension(3))
+  {
+    const Cell& c = complex.cell(id);
+    const auto* g = std::get_if<complex::ImplicitGeometry>(&c.geometry);
+    if (!g || !g->carriers.empty() || g->inside.empty())
+    {
+      throw std::invalid_argument("cell '" + c.name +
+        "': the CGAL backend meshes implicit 3D cells (inside fields) only, not " +
+        complex::kindCode(c.kind) + " cells of this form");
+    }
+    Solid s;
+    s.id = id;
+    s.name = c.name;
+    s.priority = c.priority;
+    s.box = g->bounds;
+    s.inside = g->inside;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (!std::isfinite(s.box.lo[a]) || !std::isfinite(s.box.hi[a]) || !s.box.valid())
+      {
+        throw std::invalid_argument(
+          "cell '" + c.name + "': the CGAL backend needs finite, valid bounds");
+      }
+    }
+    solids.push_back(std::move(s));
+  }
+  if (solids.empty())
+  {
+    throw std::invalid_argument("the complex has no 3D cell to mesh");
+  }
+  return solids;
+}
+
+/// The label function of the domain. Each thread gets its own field evaluators (FieldEvaluator is
+/// not thread safe); CGAL copies the function object, so copies share this oracle.
+class Labeller
+{
+public:
+  Labeller(
+    const std::vector<Solid>& solids, double overlapTolerance, std::function<bool(double)> progress)
+    : solids_(solids)
+    , tolerance_(overlapTolerance)
+    , progress_(std::move(progress))
+  {
+  }
+
+  /// 0 outside every solid, else the 1-based index of the solid holding p.
+  int label(const Point3& p)
+  {
+    Local& l = local();
+    if (progress_ && (++l.calls & 0xFFF) == 0 && !progress_(phase_))
+    {
+      throw frep::Cancelled();
+    }
+    int best = -1;
+    double bestDepth = -1;
+    for (std::size_t i = 0; i < solids_.size(); ++i)
+    {
+      const Solid& s = solids_[i];
+      if (!inBox(p, s.box) || !inside(l, i, p))
+      {
+        continue;
+      }
+      if (best < 0 || s.priority > solids_[best].priority)
+      {
+        best = static_cast<int>(i);
+        bestDepth = -1;
+        continue;
+      }
+      if (s.priority < solids_[best].priority)
+      {
+        continue;
+      }
+      // Equal priority: fine on a shared boundary (both depths about 0), an error inside both.
+      if (bestDepth < 0)
+      {
+        bestDepth = depth(l, static_cast<std::size_t>(best), p);
+      }
+      const double d = depth(l, i, p);
+      if (d > tolerance_ && bestDepth > tolerance_)
+      {
+        throw std::invalid_argument("cells '" + solids_[best].name + "' and '" + s.name +
+          "' overlap at " + pointText(p) + " and have the same priority (" +
+          std::to_string(s.priority) + "); give one of them a higher priority");
+      }
+      if (d > bestDepth)
+      {
+        best = static_cast<int>(i);
+        bestDepth = d;
+      }
+    }
+    return best + 1;
+  }
+
+  void setPhase(double fraction) { phase_ = fraction; }
+
+private:
+  struct Local
+  {
+    std::vector<std::vector<std::unique_ptr<frep::FieldEvaluator>>> evaluators;
+    std::uint64_t calls = 0;
+  };
+
+  Local& local()
+  {
+    Local& l = local_.local();
+    if (l.evaluators.empty())
+    {
+      for (const Solid& s : solids_)
+      {
+        std::vector<std::unique_ptr<frep::FieldEvaluator>> e;
+        for (const FieldPtr& f : s.inside)
+        {
+          e.push_back(f->evaluator());
+        }
+        l.evaluators.push_back(std::move(e));
+      }
+    }
+    return l;
+  }
+
+  static bool inside(Local& l, std::size_t i, const Point3& p)
+  {
+    for (auto& e : l.evaluators[i])
+    {
+      const double v = e->value(p);
+      if (!(v >= 0))
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  /// Distance estimate from p (inside the solid) to its boundary: min of f / |grad f|.
+  static double depth(Local& l, std::size_t i, const Point3& p)
+  {
+    double d = std::numeric_limits<double>::infinity();
+    for (auto& e : l.evaluators[i])
+    {
+      Point3 g;
+      const double v = e->gradient(p, g);
+      const double n = std::sqrt(dot(g, g));
+      d = std::min(d, n > 1e-12 ? v / n : v);
+    }
+    return d;
+  }
+
+  const std::vector<Solid>& solids_;
+  double tolerance_;
+  std::function<bool(double)> progress_;
+  double phase_ = 0;
+  tbb::enumerable_thread_specific<Local> local_;
+};
+
+/// Where two solids of equal priority have overlapping boxes, samples the overlap so that an
+/// overlap is reported before meshing, deterministically.
+void checkOverlaps(const std::vector<Solid>& solids, Labeller& labeller, double size)
+{
+  for (std::size_t i = 0; i < solids.size(); ++i)
+  {
+    for (std::size_t j = i + 1; j < solids.size(); ++j)
+    {
+      if (solids[i].priority != solids[j].priority)
+      {
+        continue;
+      }
+      Box3 o;
+      for (int a = 0; a < 3; ++a)
+      {
+        o.lo[a] = std::max(solids[i].box.lo[a], solids[j].box.lo[a]);
+        o.hi[a] = std::min(solids[i].box.hi[a], solids[j].box.hi[a]);
+      }
+      if (!o.valid())
+      {
+        continue;
+      }
+      // About size / 2 apart, at most ~2e5 samples per pair.
+      std::array<int, 3> n{};
+      double h = size / 2;
+      for (;;)
+      {
+        double count = 1;
+        for (int a = 0; a < 3; ++a)
+        {
+          n[a] = 1 + static_cast<int>(std::ceil((o.hi[a] - o.lo[a]) / h));
+          count *= n[a];
+        }
+        if (count <= 2e5)
+        {
+          break;
+        }
+        h *= 1.5;
+      }
+      for (int x = 0; x <= n[0]; ++x)
+      {
+        for (int y = 0; y <= n[1]; ++y)
+        {
+          for (int z = 0; z <= n[2]; ++z)
+          {
+            const Point3 p{ o.lo[0] + (o.hi[0] - o.lo[0]) * x / n[0],
+              o.lo[1] + (o.hi[1] - o.lo[1]) * y / n[1], o.lo[2] + (o.hi[2] - o.lo[2]) * z / n[2] };
+            labeller.label(p); // throws for an overlap
+          }
+        }
+      }
+    }
+  }
+}
+
+// --- feature curves ---------------------------------------------------------------------------
+
+void appendCurves(const discretize::CurveSet& curves, std::vector<Polyline>& out)
+{
+  for (const auto& line : curves.lines)
+  {
+    Polyline p;
+    for (auto i : line)
+    {
+      p.push_back(curves.points[i]);
+    }
+    out.push_back(std::move(p));
+  }
+}
+
+/// {f = 0, g = 0, trims >= 0} in the box; nothing when the two surfaces coincide or touch (no
+/// curve to protect there) or the tracer gives up.
+void traceFeature(const frep::FieldPtr& f, const frep::FieldPtr& g,
+  const std::vector<FieldPtr>& trims, const Box3& box, double step, int threads,
+  std::vector<Polyline>& out)
+{
+  discretize::CurveOptions o;
+  o.step = step;
+  o.threads = threads;
+  o.maxSeedBoxes = 1e6;
+  o.maxPoints = 1e6;
+  try
+  {
+    appendCurves(discretize::traceCurve(*f, *g, trims, box, o), out);
+  }
+  catch (const frep::Cancelled&)
+  {
+    throw;
+  }
+  catch (const std::exception&)
+  {
+    // Coincident boundaries (two cells sharing a face), tangent contacts: not curves.
+  }
+}
+
+/// Drops repeated points and too short polylines.
+void cleanPolylines(std::vector<Polyline>& lines, double tolerance)
+{
+  std::vector<Polyline> out;
+  for (auto& line : lines)
+  {
+    Polyline p;
+    for (const auto& q : line)
+    {
+      if (p.empty() || dist(p.back(), q) > tolerance * 1e-3)
+      {
+        p.push_back(q);
+      }
+    }
+    const bool closed = line.size() > 2 && line.front() == line.back();
+    if (closed && p.size() > 1 && p.back() != p.front())
+    {
+      if (dist(p.back(), p.front()) <= tolerance * 1e-3)
+      {
+        p.back() = p.front();
+      }
+      else
+      {
+        p.push_back(p.front());
+      }
+    }
+    double length = 0;
+    for (std::size_t i = 1; i < p.size(); ++i)
+    {
+      length += dist(p[i - 1], p[i]);
+    }
+    if (p.size() >= 2 && length > tolerance && !(p.size() <= 3 && p.front() == p.back()))
+    {
+      out.push_back(std::move(p));
+    }
+  }
+  lines = std::move(out);
+}
+
+double distanceToPolyline(const Point3& p, const Polyline& line)
+{
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < line.size(); ++i)
+  {
+    best = std::min(best, dist(p, nearestOnSegment(p, line[i - 1], line[i])));
+  }
+  return best;
+}
+
+bool isClosed(const Polyline& p)
+{
+  return p.size() > 2 && p.front() == p.back();
+}
+
+/// Merges the candidate curves into a set CGAL accepts: a curve lying along an accepted one (every
+/// point within `duplicate`) is dropped, end points closer than `snap` become one corner, and a
+/// curve with a corner on its interior is split there.
+std::vector<Polyline> mergeFeatures(
+  const std::vector<Polyline>& candidates, double duplicate, double snap)
+{
+  std::vector<Polyline> accepted;
+  for (const auto& c : candidates)
+  {
+    bool covered = !accepted.empty();
+    for (const auto& q : c)
+    {
+      double d = std::numeric_limits<double>::infinity();
+      for (const auto& a : accepted)
+      {
+        d = std::min(d, distanceToPolyline(q, a));
+        if (d <= duplicate)
+        {
+          break;
+        }
+      }
+      if (d > duplicate)
+      {
+        covered = false;
+        break;
+      }
+    }
+    if (!covered)
+    {
+      accepted.push_back(c);
+    }
+  }
+  // Corners: end points of open curves, clustered.
+  std::vector<Point3> corners;
+  auto corner = [&](Point3& p)
+  {
+    for (const auto& c : corners)
+    {
+      if (dist(c, p) <= snap)
+      {
+        p = c;
+        return;
+      }
+    }
+    corners.push_back(p);
+  };
+  for (auto& a : accepted)
+  {
+    if (!isClosed(a))
+    {
+      corner(a.front());
+      corner(a.back());
+    }
+  }
+  // Split curves at corners on their interior (a closed curve through a corner becomes two open
+  // curves, from the corner to its opposite point and back).
+  bool changed = true;
+  while (changed)
+  {
+    changed = false;
+    for (std::size_t k = 0; k < accepted.size() && !changed; ++k)
+    {
+      Polyline& a = accepted[k];
+      for (const auto& c : corners)
+      {
+        if (!isClosed(a) && (a.front() == c || a.back() == c))
+        {
+          continue;
+        }
+        // Nearest segment.
+        std::size_t seg = 0;
+        double best = std::numeric_limits<double>::infinity();
+        for (std::size_t i = 1; i < a.size(); ++i)
+        {
+          const double d = dist(c, nearestOnSegment(c, a[i - 1], a[i]));
+          if (d < best)
+          {
+            best = d;
+            seg = i;
+          }
+        }
+        if (!(best <= snap))
+        {
+          continue;
+        }
+        // Insert c as a vertex: replace a near vertex, else add it inside segment `seg`.
+        std::size_t at = 0;
+        if (dist(c, a[seg - 1]) <= snap && (seg - 1 > 0 || isClosed(a)))
+        {
+          at = seg - 1;
+          a[at] = c;
+        }
+        else if (dist(c, a[seg]) <= snap && (seg < a.size() - 1 || isClosed(a)))
+        {
+          at = seg;
+          a[at] = c;
+        }
+        else
+        {
+          a.insert(a.begin() + static_cast<std::ptrdiff_t>(seg), c);
+          at = seg;
+        }
+        if (isClosed(a) || at == 0 || at == a.size() - 1)
+        {
+          if (at == 0 || at == a.size() - 1)
+          {
+            // A closed curve through its own start point: make the corner its start.
+            a.front() = c;
+            a.back() = c;
+          }
+          // Rotate so the closed curve starts at c, then split at the opposite vertex.
+          Polyline loop(a.begin(), a.end() - 1); // drop the repeated end
+          std::rotate(
+            loop.begin(), loop.begin() + static_cast<std::ptrdiff_t>(at % loop.size()), loop.end());
+          loop.push_back(loop.front());
+          const std::size_t half = loop.size() / 2;
+          Polyline first(loop.begin(), loop.begin() + static_cast<std::ptrdiff_t>(half) + 1);
+          Polyline second(loop.begin() + static_cast<std::ptrdiff_t>(half), loop.end());
+          corners.push_back(loop[half]);
+          a = std::move(first);
+          accepted.push_back(std::move(second));
+        }
+        else
+        {
+          Polyline second(a.begin() + static_cast<std::ptrdiff_t>(at), a.end());
+          a.resize(at + 1);
+          accepted.push_back(std::move(second));
+        }
+        changed = true;
+        break;
+      }
+    }
+  }
+  return accepted;
+}
+
+std::vector<Polyline> featureCurves(const Complex& complex, const std::vector<Solid>& solids,
+  const Box3& domainBox, const TetraOptions& options)
+{
+  const double size = options.size;
+  const double step = size / 4;
+  const double pad = 1e-7 * diagonal(domainBox);
+  std::vector<Polyline> candidates;
+  // 1D cells first: they are the user's curves.
+  for (CellId id : complex.cellsOfDimension(1))
+  {
+    complex::DiscretizationOptions d;
+    d.featureSize = step;
+    d.threads = options.threads;
+    const complex::CellMesh m = complex::discretizeCell(complex, id, d);
+    std::vector<Polyline> lines;
+    appendCurves(m.curves, lines);
+    for (auto& l : lines)
+    {
+      const bool near = std::any_of(
+        l.begin(), l.end(), [&](const Point3& p) { return inBox(p, padded(domainBox, size)); });
+      if (near)
+      {
+        candidates.push_back(std::move(l));
+      }
+    }
+  }
+  // Creases of each solid: where two of its inside fields vanish.
+  for (const Solid& s : solids)
+  {
+    for (std::size_t k = 0; k < s.inside.size(); ++k)
+    {
+      for (std::size_t m = k + 1; m < s.inside.size(); ++m)
+      {
+        std::vector<FieldPtr> trims;
+        for (std::size_t r = 0; r < s.inside.size(); ++r)
+        {
+          if (r != k && r != m)
+          {
+            trims.push_back(s.inside[r]);
+          }
+        }
+        traceFeature(
+          s.inside[k], s.inside[m], trims, padded(s.box, pad), step, options.threads, candidates);
+      }
+    }
+  }
+  // Curves where the boundaries of two solids meet.
+  for (std::size_t i = 0; i < solids.size(); ++i)
+  {
+    for (std::size_t j = i + 1; j < solids.size(); ++j)
+    {
+      const Solid& a = solids[i];
+      const Solid& b = solids[j];
+      Box3 o;
+      for (int ax = 0; ax < 3; ++ax)
+      {
+        o.lo[ax] = std::max(a.box.lo[ax], b.box.lo[ax]);
+        o.hi[ax] = std::min(a.box.hi[ax], b.box.hi[ax]);
+      }
+      if (!o.valid())
+      {
+        continue;
+      }
+      for (std::size_t k = 0; k < a.inside.size(); ++k)
+      {
+        for (std::size_t m = 0; m < b.inside.size(); ++m)
+        {
+          std::vector<FieldPtr> trims;
+          for (std::size_t r = 0; r < a.inside.size(); ++r)
+          {
+            if (r != k)
+            {
+              trims.push_back(a.inside[r]);
+            }
+          }
+          for (std::size_t r = 0; r < b.inside.size(); ++r)
+          {
+            if (r != m)
+            {
+              trims.push_back(b.inside[r]);
+            }
+          }
+          traceFeature(
+            a.inside[k], b.inside[m], trims, padded(o, pad), step, options.threads, candidates);
+        }
+      }
+    }
+  }
+  cleanPolylines(candidates, 1e-3 * size);
+  auto merged = mergeFeatures(candidates, 0.02 * size, 1e-3 * size);
+  cleanPolylines(merged, 1e-3 * size);
+  return merged;
+}
+
+Box3 domainBox(const std::vector<Solid>& solids)
+{
+  Box3 b = solids.front().box;
+  for (const Solid& s : solids)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      b.lo[a] = std::min(b.lo[a], s.box.lo[a]);
+      b.hi[a] = std::max(b.hi[a], s.box.hi[a]);
+    }
+  }
+  return b;
+}
+
+void checkOptions(const TetraOptions& options)
+{
+  if (!(options.size > 0) || !std::isfinite(options.size))
+  {
+    throw std::invalid_argument("the mesh size must be a positive number");
+  }
+}
+
+/// Initial surface points for every solid, found deterministically: a point holding the solid's
+/// label (a grid search in its box), then CGAL's own segment intersection along 14 directions
+/// from it. Points near a protected curve are skipped (a point inside a protecting ball is hidden
+/// by it anyway; one just outside would crowd it).
+void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& solids,
+  Labeller& labeller, const std::vector<Polyline>& features, const Box3& outer, double size)
+{
+  const double reach = 2 * diagonal(outer);
+  auto cwp = c3t3.triangulation().geom_traits().construct_weighted_point_3_object();
+  const auto intersects = domain.do_intersect_surface_object();
+  const auto intersection = domain.construct_intersection_object();
+  for (std::size_t i = 0; i < solids.size(); ++i)
+  {
+    const Box3& b = solids[i].box;
+    std::optional<Point3> seed;
+    for (int n = 4; n <= 64 && !seed; n *= 2)
+    {
+      for (int x = 0; x < n && !seed; ++x)
+      {
+        for (int y = 0; y < n && !seed; ++y)
+        {
+          for (int z = 0; z < n && !seed; ++z)
+          {
+            const Point3 q{ b.lo[0] + (b.hi[0] - b.lo[0]) * (x + 0.5) / n,
+              b.lo[1] + (b.hi[1] - b.lo[1]) * (y + 0.5) / n,
+              b.lo[2] + (b.hi[2] - b.lo[2]) * (z + 0.5) / n };
+            if (labeller.label(q) == static_cast<int>(i) + 1)
+            {
+              seed = q;
+            }
+          }
+        }
+      }
+    }
+    if (!seed)
+    {
+      continue;
+    }
+    for (int dx = -1; dx <= 1; ++dx)
+    {
+      for (int dy = -1; dy <= 1; ++dy)
+      {
+        for (int dz = -1; dz <= 1; ++dz)
+        {
+          const int nonzero = (dx != 0) + (dy != 0) + (dz != 0);
+          if (nonzero != 1 && nonzero != 3)
+          {
+            continue;
+          }
+          const double s = reach / std::sqrt(static_cast<double>(nonzero));
+          const K::Point_3 from((*seed)[0], (*seed)[1], (*seed)[2]);
+          const K::Point_3 to(from.x() + s * dx, from.y() + s * dy, from.z() + s * dz);
+          const K::Segment_3 segment(from, to);
+          const auto surface = intersects(segment);
+          if (!surface)
+          {
+            continue;
+          }
+          const auto hit = intersection(segment);
+          const K::Point_3& q = std::get<0>(hit);
+          const Point3 point{ q.x(), q.y(), q.z() };
+          const bool nearCurve = std::any_of(features.begin(), features.end(),
+            [&](const Polyline& f) { return distanceToPolyline(point, f) < 0.5 * size; });
+          if (nearCurve)
+          {
+            continue;
+          }
+          const auto v = c3t3.triangulation().insert(cwp(q));
+          if (v != Tr::Vertex_handle())
+          {
+            c3t3.set_dimension(v, 2);
+            c3t3.set_index(v, domain.index_from_surface_patch_index(*surface));
+          }
+        }
+      }
+    }
+  }
+}
+
+void report(const TetraOptions& options, double fraction)
+{
+  if (options.progress && !options.progress(fraction))
+  {
+    throw frep::Cancelled();
+  }
+}
+
+} // namespace
+
+std::vector<std::vector<Point3>> cgalFeatureCurves(
+  const complex::Complex& complex, const TetraOptions& options)
+{
+  checkOptions(options);
+  const auto solids = collectSolids(complex);
+  return featureCurves(complex, solids, domainBox(solids), options);
+}
+
+TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& options)
+{
+  checkOptions(options);
+  const std::vector<Solid> solids = collectSolids(complex);
+  double volume = 0;
+  for (const Solid& s : solids)
+  {
+    volume +=
+      (s.box.hi[0] - s.box.lo[0]) * (s.box.hi[1] - s.box.lo[1]) * (s.box.hi[2] - s.box.lo[2]);
+  }
+  const double estimate = estimateTetrahedra(volume, options.size);
+  if (estimate > options.maxTetrahedra)
+  {
+    std::ostringstream s;
+    s << "size " << options.size << " would give about " << std::llround(estimate)
+      << " tetrahedra (bounding volume " << volume << "), above the limit of "
+      << options.maxTetrahedra << ": use a larger size or raise maxTetrahedra";
+    throw std::invalid_argument(s.str());
+  }
+  report(options, 0);
+
+  const Box3 box = domainBox(solids);
+  const double diag = diagonal(box);
+  auto labeller = std::make_shared<Labeller>(solids, 1e-3 * options.size, options.progress);
+  checkOverlaps(solids, *labeller, options.size);
+  const std::vector<Polyline> features = featureCurves(complex, solids, box, options);
+  report(options, 0.1);
+
+  // The domain: the label function, a box a little larger than the cells' (so that faces on the
+  // cells' bounds are seen as surfaces), bisection to 1e-10 of the diagonal.
+  const Box3 outer = padded(box, 0.02 * diag + options.size);
+  CGAL::Random rng(0);
+  if (options.deterministic)
+  {
+    CGAL::get_default_random() = CGAL::Random(0);
+  }
+  std::function<int(const K::Point_3&)> function = [labeller](const K::Point_3& p)
+  {
+    return labeller->label({ p.x(), p.y(), p.z() });
+  };
+  Domain domain(function,
+    K::Iso_cuboid_3(K::Point_3(outer.lo[0], outer.lo[1], outer.lo[2]),
+      K::Point_3(outer.hi[0], outer.hi[1], outer.hi[2])),
+    K::FT(1e-10), CGAL::Null_subdomain_index(), &rng);
+  {
+    std::vector<std::vector<K::Point_3>> lines;
+    for (const auto& f : features)
+    {
+      std::vector<K::Point_3> l;
+      for (const auto& p : f)
+      {
+        l.emplace_back(p[0], p[1], p[2]);
+      }
+      lines.push_back(std::move(l));
+    }
+    domain.add_features(lines.begin(), lines.end());
+  }
+
+  // CGAL's sizes are circumradius bounds. Delaunay refinement leaves most elements well below
+  // them: with the regular-element radii (h / sqrt 3, h sqrt(6) / 4) the sphere-in-box benchmark
+  // came out with 2.3 times estimateTetrahedra's count (mean element about 0.76 h). These bounds
+  // make the mean tetrahedron about the volume of a regular one of edge h, as the estimate says.
+  const double h = options.size;
+  namespace p = CGAL::parameters;
+  Criteria criteria(p::edge_size = h, p::facet_angle = 25, p::facet_size = kFacetRadius * h,
+    p::facet_distance = 0.1 * h, p::cell_radius_edge_ratio = 3, p::cell_size = kCellRadius * h);
+
+  labeller->setPhase(0.1);
+  // make_mesh_3's steps, with initial surface points on every solid: CGAL shoots random rays from
+  // the box's centre only when the protected curves give no surface facet, and so misses solids
+  // away from the curves (the flower's stamen).
+  C3t3 c3t3;
+  CGAL::Mesh_3::internal::C3t3_initializer<C3t3, Domain, Criteria, true>()(
+    c3t3, domain, criteria, true);
+  seedSurfaces(c3t3, domain, solids, *labeller, features, outer, h);
+  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::no_reset_c3t3());
+  report(options, 0.6);
+  if (!options.deterministic)
+  {
+    labeller->setPhase(0.6);
+    CGAL::perturb_mesh_3(
+      c3t3, domain, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
+    report(options, 0.8);
+    labeller->setPhase(0.8);
+    CGAL::exude_mesh_3(
+      c3t3, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
+    report(options, 0.95);
+  }
+
+  // Output: the tetrahedra of the complex, vertices numbered in order of first use.
+  TetMesh mesh;
+  for (const Solid& s : solids)
+  {
+    mesh.materialNames.push_back(s.name);
+  }
+  const Tr& tr = c3t3.triangulation();
+  std::unordered_map<const void*, std::uint32_t> index;
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
+  {
+    const int label = static_cast<int>(c3t3.subdomain_index(c));
+    if (label < 1 || static_cast<std::size_t>(label) > solids.size())
+    {
+      continue;
+    }
+    std::array<std::uint32_t, 4> tet{};
+    for (int k = 0; k < 4; ++k)
+    {
+      const auto v = c->vertex(k);
+      const auto [it, added] = index.emplace(&*v, static_cast<std::uint32_t>(mesh.points.size()));
+      if (added)
+      {
+        const auto& wp = tr.point(c, k);
+        mesh.points.push_back(
+          { CGAL::to_double(wp.x()), CGAL::to_double(wp.y()), CGAL::to_double(wp.z()) });
+      }
+      tet[k] = it->second;
+    }
+    const Point3 a = mesh.points[tet[0]];
+    const Point3 e1 = sub(mesh.points[tet[1]], a);
+    const Point3 e2 = sub(mesh.points[tet[2]], a);
+    const Point3 e3 = sub(mesh.points[tet[3]], a);
+    const double det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
+      e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) + e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+    if (det < 0)
+    {
+      std::swap(tet[2], tet[3]);
+    }
+    mesh.tetrahedra.push_back(tet);
+    mesh.cells.push_back(solids[static_cast<std::size_t>(label - 1)].id);
+    mesh.materials.push_back(label);
+  }
+  report(options, 1);
+  return mesh;
+}
+
+} // namespace ictk::mesh

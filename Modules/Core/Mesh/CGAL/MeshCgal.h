@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// The CGAL Mesh_3 backend (issue 6). This header includes no CGAL; the library that implements it
+// links CGAL Mesh_3 (GPL-3.0-or-later) and is built only with ICTK_ENABLE_GPL_BACKENDS.
+//
+// The complex's 3D cells become one labelled domain: the label of a point is the 1-based index
+// (among the 3D cells, ascending id) of the cell that holds it (bounds and every inside field
+// >= 0), the highest Cell::priority winning where cells overlap. Curves are protected as mesh
+// edges: the 1D cells, the creases of each solid (where two of its inside fields vanish) and the
+// curves where two solids' boundaries meet. 2D cells are not inserted as internal surfaces (a
+// labelled domain only has surfaces where the label changes); explicit (B) 3D cells are refused.
+
+#include "Mesh/TetMesh.h"
+
+#include <vector>
+
+namespace ictk::mesh
+{
+
+/// A tetrahedral mesh of the complex's 3D cells (implicit cells only; cellData is left empty).
+/// options.size is met on average: the mean tetrahedron has the volume of a regular one of edge
+/// `size` (so estimateTetrahedra predicts the count) and protected curves get edges of at most
+/// `size`. Refinement is sequential (options.threads is used for tracing the curves only).
+/// options.deterministic: no perturbation or exudation and fixed seeds (identical output run to
+/// run, but slivers remain: minimum dihedral angles near 0); otherwise perturbation and
+/// exudation aim at options.minDihedralDegrees.
+/// Throws std::invalid_argument for a 3D cell that is not implicit or not bounded, for
+/// overlapping cells of equal priority (naming both and the point), or for an estimate above
+/// options.maxTetrahedra (giving the estimate); frep::Cancelled when options.progress asks to
+/// stop.
+TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& options);
+
+/// The polylines the backend protects (after merging duplicates, snapping end points and
+/// splitting at junctions), for tests and viewers.
+std::vector<std::vector<frep::Point3>> cgalFeatureCurves(
+  const complex::Complex& complex, const TetraOptions& options);
+
+} // namespace ictk::mesh
