@@ -93,6 +93,8 @@ CLI::App* AddTetraCommand(CLI::App& app, TetraOptions& o)
   tetra->add_option("--max-tets", o.MaxTetrahedra, "Refuse meshes estimated above this");
   tetra->add_option("--threads", o.Threads, "Threads (default: all cores)");
   tetra->add_flag("--json", o.Json, "Print the report as JSON");
+  tetra->add_option("--msh-version", o.MshVersion, "Gmsh file format: 4.1 (default) or 2.2")
+    ->check(CLI::IsMember({ "4.1", "2.2" }));
   return tetra;
 }
 
@@ -162,6 +164,11 @@ int RunTetra(const TetraOptions& o)
   if (EndsWith(o.Output, ".vtu"))
   {
     WriteVtu(m, o.Output);
+  }
+  else if (EndsWith(o.Output, ".msh"))
+  {
+    mesh::writeGmsh(
+      m, o.Output, o.MshVersion == "2.2" ? mesh::GmshVersion::V22 : mesh::GmshVersion::V41);
   }
   else
   {

@@ -21,6 +21,7 @@ struct TetraOptions
   double Size = 0;
   bool Deterministic = false;
   bool Json = false;
+  std::string MshVersion = "4.1";
   double MaxTetrahedra = 2e7;
   int Threads = 0;
 };

@@ -433,8 +433,19 @@ def check_tetra_bar(ictk, work, data):
         mesh = meshio.read(inp)
         if sum(len(b.data) for b in mesh.cells if b.type == "tetra") != report["tetrahedra"]:
             sys.exit("FAIL: meshio reads another tetrahedron count")
+        for version in ("2.2", "4.1"):
+            msh = os.path.join(work, f"bar-{version}.msh")
+            run(ictk, ["tetra", model, "-o", msh, "--backend", "tetgen", "--size", "0.05", "--deterministic",
+                       "--msh-version", version])
+            m = meshio.read(msh)
+            tags = set()
+            for block, data in zip(m.cells, m.cell_data.get("gmsh:physical", [])):
+                if block.type == "tetra":
+                    tags.update(int(t) for t in data)
+            if tags != {1, 2}:
+                sys.exit(f"FAIL: Gmsh {version} physical groups {tags}, not {{1, 2}}")
     except ImportError:
-        print("meshio not installed: the .inp read-back is skipped")
+        print("meshio not installed: the .inp and .msh read-backs are skipped")
     if not shutil.which("ccx"):
         print("ccx not installed: the CalculiX solve is skipped")
         return
