@@ -28,15 +28,13 @@
 #include "Lang/ComplexFile.h"
 #include "Lang/VmReader.h"
 
-#include <vtkBox.h>
-#include <vtkCylinder.h>
+#include "ictkCsgRecipeToVtk.h"
+
 #include <vtkImageData.h>
-#include <vtkImplicitBoolean.h>
 #include <vtkImplicitFunction.h>
 #include <vtkSMPTools.h>
 #include <vtkSampleFunction.h>
 #include <vtkSmartPointer.h>
-#include <vtkSphere.h>
 
 #include <nlohmann/json.hpp>
 
@@ -226,57 +224,6 @@ Result Prospero(const frep::TapePtr& tape, bool prune, int size, bool jit = fals
 
 // --- csg3 against VTK ---------------------------------------------------------------------------
 
-vtkSmartPointer<vtkImplicitFunction> ToVtk(const bundled::CsgRecipe& r, int index)
-{
-  const CsgNode& n = r.nodes.at(static_cast<std::size_t>(index));
-  switch (n.kind)
-  {
-    case CsgNode::Kind::Sphere:
-    {
-      auto s = vtkSmartPointer<vtkSphere>::New();
-      s->SetCenter(n.p[0], n.p[1], n.p[2]);
-      s->SetRadius(n.p[3]);
-      return s;
-    }
-    case CsgNode::Kind::Box:
-    {
-      auto b = vtkSmartPointer<vtkBox>::New();
-      b->SetBounds(n.p[0], n.p[3], n.p[1], n.p[4], n.p[2], n.p[5]);
-      return b;
-    }
-    case CsgNode::Kind::CylinderY:
-    {
-      auto c = vtkSmartPointer<vtkCylinder>::New();
-      c->SetCenter(n.p[0], n.p[1], n.p[2]);
-      c->SetRadius(n.p[3]);
-      c->SetAxis(0, 1, 0);
-      return c;
-    }
-    case CsgNode::Kind::Union:
-    case CsgNode::Kind::Intersection:
-    case CsgNode::Kind::Difference:
-    {
-      auto op = vtkSmartPointer<vtkImplicitBoolean>::New();
-      if (n.kind == CsgNode::Kind::Union)
-      {
-        op->SetOperationTypeToUnion();
-      }
-      else if (n.kind == CsgNode::Kind::Intersection)
-      {
-        op->SetOperationTypeToIntersection();
-      }
-      else
-      {
-        op->SetOperationTypeToDifference();
-      }
-      op->AddFunction(ToVtk(r, n.a));
-      op->AddFunction(ToVtk(r, n.b));
-      return op;
-    }
-  }
-  throw std::logic_error("bench: bad CSG node");
-}
-
 Result Csg3(int size)
 {
   Result r;
@@ -289,7 +236,7 @@ Result Csg3(int size)
   const frep::ModelInfo& info = frep::findModel("csg3");
   const frep::TapePtr tape = frep::Tape::compile(info.build().geometry().function());
   const bundled::CsgRecipe recipe = bundled::csg3Recipe();
-  vtkSmartPointer<vtkImplicitFunction> vtkFunction = ToVtk(recipe, recipe.root);
+  vtkSmartPointer<vtkImplicitFunction> vtkFunction = ictkCsgRecipeToVtk(recipe);
 
   // The same shape: ICTK's field is minus VTK's, so the signs must be opposite wherever the
   // value is not within rounding of zero.

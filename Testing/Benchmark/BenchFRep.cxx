@@ -17,18 +17,16 @@
 #include <benchmark/benchmark.h>
 #include <tbb/info.h>
 
-#include <vtkBox.h>
-#include <vtkCylinder.h>
+#include "ictkCsgRecipeToVtk.h"
+
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
-#include <vtkImplicitBoolean.h>
 #include <vtkImplicitFunction.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkSMPTools.h>
 #include <vtkSampleFunction.h>
 #include <vtkSmartPointer.h>
-#include <vtkSphere.h>
 
 #include <algorithm>
 #include <cmath>
@@ -70,63 +68,12 @@ CsgRecipe recipeFor(const std::string& model)
   return bundled::random1000Recipe();
 }
 
-vtkSmartPointer<vtkImplicitFunction> toVtk(const CsgRecipe& r, int index)
-{
-  const CsgNode& n = r.nodes.at(static_cast<std::size_t>(index));
-  switch (n.kind)
-  {
-    case CsgNode::Kind::Sphere:
-    {
-      auto s = vtkSmartPointer<vtkSphere>::New();
-      s->SetCenter(n.p[0], n.p[1], n.p[2]);
-      s->SetRadius(n.p[3]);
-      return s;
-    }
-    case CsgNode::Kind::Box:
-    {
-      auto b = vtkSmartPointer<vtkBox>::New();
-      b->SetBounds(n.p[0], n.p[3], n.p[1], n.p[4], n.p[2], n.p[5]);
-      return b;
-    }
-    case CsgNode::Kind::CylinderY:
-    {
-      auto c = vtkSmartPointer<vtkCylinder>::New();
-      c->SetCenter(n.p[0], n.p[1], n.p[2]);
-      c->SetRadius(n.p[3]);
-      c->SetAxis(0, 1, 0);
-      return c;
-    }
-    case CsgNode::Kind::Union:
-    case CsgNode::Kind::Intersection:
-    case CsgNode::Kind::Difference:
-    {
-      auto op = vtkSmartPointer<vtkImplicitBoolean>::New();
-      if (n.kind == CsgNode::Kind::Union)
-      {
-        op->SetOperationTypeToUnion();
-      }
-      else if (n.kind == CsgNode::Kind::Intersection)
-      {
-        op->SetOperationTypeToIntersection();
-      }
-      else
-      {
-        op->SetOperationTypeToDifference();
-      }
-      op->AddFunction(toVtk(r, n.a));
-      op->AddFunction(toVtk(r, n.b));
-      return op;
-    }
-  }
-  return nullptr;
-}
-
 vtkSmartPointer<vtkSampleFunction> vtkSampler(const std::string& model, std::int64_t n)
 {
   const ModelInfo& info = findModel(model);
   auto sample = vtkSmartPointer<vtkSampleFunction>::New();
   const CsgRecipe recipe = recipeFor(model);
-  sample->SetImplicitFunction(toVtk(recipe, recipe.root));
+  sample->SetImplicitFunction(ictkCsgRecipeToVtk(recipe));
   sample->SetModelBounds(info.boundsLo[0], info.boundsHi[0], info.boundsLo[1], info.boundsHi[1],
     info.boundsLo[2], info.boundsHi[2]);
   sample->SetSampleDimensions(static_cast<int>(n), static_cast<int>(n), static_cast<int>(n));
