@@ -6,6 +6,7 @@
 #include "FRep/Sampling.h"
 #include "Lang/ComplexFile.h"
 #include "Mesh/CGAL/MeshCgal.h"
+#include "Mesh/Quality.h"
 
 #include <gtest/gtest.h>
 
@@ -24,19 +25,8 @@ using frep::Point3;
 double tetVolume(const mesh::TetMesh& m, std::size_t t)
 {
   const auto& tet = m.tetrahedra[t];
-  const Point3& a = m.points[tet[0]];
-  double e[3][3];
-  for (int k = 0; k < 3; ++k)
-  {
-    for (int c = 0; c < 3; ++c)
-    {
-      e[k][c] = m.points[tet[k + 1]][c] - a[c];
-    }
-  }
-  return (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-           e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-           e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
-    6;
+  return mesh::tetShape(m.points[tet[0]], m.points[tet[1]], m.points[tet[2]], m.points[tet[3]])
+    .volume;
 }
 
 std::map<int, double> materialVolumes(const mesh::TetMesh& m)

@@ -2,6 +2,7 @@
 // The TetGen backend (issue 6): volumes, conforming material interfaces, determinism, errors.
 #include "Complex/Complex.h"
 #include "FRep/Expr.h"
+#include "Mesh/Quality.h"
 #include "Mesh/TetGen/MeshTetGen.h"
 
 #include <gtest/gtest.h>
@@ -50,19 +51,8 @@ Cell ball(const std::string& name, const Point3& c, double r, double priority = 
 double volume(const mesh::TetMesh& m, std::size_t t)
 {
   const auto& tet = m.tetrahedra[t];
-  const Point3& a = m.points[tet[0]];
-  double e[3][3];
-  for (int k = 0; k < 3; ++k)
-  {
-    for (int c = 0; c < 3; ++c)
-    {
-      e[k][c] = m.points[tet[k + 1]][c] - a[c];
-    }
-  }
-  return (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-           e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-           e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
-    6;
+  return mesh::tetShape(m.points[tet[0]], m.points[tet[1]], m.points[tet[2]], m.points[tet[3]])
+    .volume;
 }
 
 double materialVolume(const mesh::TetMesh& m, int material)
