@@ -288,15 +288,16 @@ TEST(IcmModels, DependencyModel)
   const icm::Instance* t = m.instance("INITIAL_TEMPLATE");
   ASSERT_NE(t, nullptr);
   const auto& deps = t->relations[0].dependency;
-  ASSERT_EQ(deps.size(), 2u);
+  ASSERT_EQ(deps.size(), 1u);
   EXPECT_TRUE(deps[0].hierarchical);
   EXPECT_EQ(deps[0].name.text, "LINE_DISK");
   EXPECT_EQ(deps[0].ends[0]->text, "OM"); // the master first
   EXPECT_EQ(deps[0].ends[1]->text, "LHKF");
-  EXPECT_FALSE(deps[1].hierarchical);
-  EXPECT_DOUBLE_EQ(deps[1].priority, 2.0);
-  EXPECT_EQ(deps[1].ends[1]->text, "radius");
   EXPECT_EQ(m.instance("K4")->base.text, "INITIAL_TEMPLATE");
+  ASSERT_EQ(m.animations.size(), 1u);
+  EXPECT_EQ(m.animations[0].name.text, "animCurve1");
+  ASSERT_NE(m.animations[0].property("keys"), nullptr);
+  EXPECT_EQ(m.animations[0].property("keys")->values.size(), 2u);
 }
 
 TEST(IcmModels, NewtonsCradle)
@@ -312,9 +313,14 @@ TEST(IcmModels, NewtonsCradle)
   ASSERT_EQ(m.events.size(), 1u);
   EXPECT_EQ(m.events[0].name.text, "COLLISION");
   EXPECT_EQ(m.cell("B2")->source.text, "B1");
-  ASSERT_EQ(contact->reactions.size(), 3u);
-  EXPECT_EQ(contact->reactions[2].name.text, "react");
-  EXPECT_EQ(contact->reactions[2].formals[0].type, "COLLISION");
+  ASSERT_EQ(contact->reactions.size(), 2u);
+  EXPECT_EQ(contact->reactions[1].name.text, "react");
+  EXPECT_EQ(contact->reactions[1].formals[0].type, "COLLISION");
+  // the balls' own updates, replaced while they touch
+  ASSERT_EQ(contact->cells.size(), 1u);
+  ASSERT_EQ(contact->cells[0].reactions.size(), 2u);
+  EXPECT_EQ(contact->cells[0].reactions[0].cell.text, "B1");
+  EXPECT_EQ(m.cycles.text, "previous");
 }
 
 TEST(IcmModels, Andyhausen)
@@ -673,6 +679,17 @@ TEST(IcmDiagnostics, LineColumnAndMessage)
       "CELLS { S { shape = hyperfun { s(x[3], a[1]) { s = 1 - q; } "
       "}; } }",
       "1:56: error: in the hyperfun shape: unknown variable 'q'" },
+    { "animation without keys", "ANIMATIONS { a { interpolation = linear; } }",
+      "1:14: error: the animation 'a' has no keys" },
+    { "animation key width", "ANIMATIONS { a { keys = { 0, 1 }, { 1, 2, 3, 4 }; } }",
+      "1:35: error: every key of an animation has the same number of values" },
+    { "animation interpolation", "ANIMATIONS { a { keys = { 0, 1 }; interpolation = cubic; } }",
+      "1:35: error: unknown interpolation (step, linear, catmullrom or hermite)" },
+    { "undefined animation",
+      header + t +
+        "K : T { REACTIONS { init(REAL g) { A.p = animationValue(\"walk\", g); } } }",
+      "3:57: error: undefined animation \"walk\"" },
+    { "cycle policy", "cycles = sometimes;", "1:10: error: unknown cycle policy 'sometimes'" },
     { "self dependency", header + t + "K : T { RELATIONS { dependency { A.p A.p; } } }",
       "3:34: error: 'A.p' cannot depend on itself" },
   };

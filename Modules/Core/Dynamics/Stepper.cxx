@@ -45,8 +45,26 @@ std::size_t Stepper::addReaction(Reaction r)
 
 void Stepper::setDependencies(DependencyGraph graph)
 {
+  // A relation the new plan shares with the old one (same ends and parameters) keeps its
+  // validity: only relations that are new, or whose master changed, copy values.
+  std::map<std::string, double> kept;
+  for (std::size_t r = 0; r < graph_.relations().size() && r < lastPulled_.size(); ++r)
+  {
+    const DependencyRelation& d = graph_.relations()[r];
+    kept[d.master + "." + d.masterParam + ">" + d.dependent + "." + d.dependentParam] =
+      lastPulled_[r];
+  }
   graph_ = std::move(graph);
   plan_ = graph_.plan();
+  lastPulled_.assign(graph_.relations().size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t r = 0; r < graph_.relations().size(); ++r)
+  {
+    const DependencyRelation& d = graph_.relations()[r];
+    const auto it =
+      kept.find(d.master + "." + d.masterParam + ">" + d.dependent + "." + d.dependentParam);
+    if (it != kept.end())
+      lastPulled_[r] = it->second;
+  }
   const std::size_t n = graph_.entityCount();
   entityReaction_.assign(n, std::nullopt);
   incoming_.assign(n, {});
@@ -69,9 +87,22 @@ void Stepper::setDependencies(DependencyGraph graph)
       reactionOrder_.push_back(i);
 }
 
+void Stepper::setExternalState(
+  std::function<std::any()> save, std::function<void(const std::any&)> restore)
+{
+  saveExternal_ = std::move(save);
+  restoreExternal_ = std::move(restore);
+}
+
 Stepper::Snapshot Stepper::save() const
 {
-  return Snapshot{ params_, queue_, t_, alive_, log_.size(), processed_.size(), accepted_.size() };
+  return Snapshot{ params_, queue_, t_, alive_, log_.size(), processed_.size(), accepted_.size(),
+    lastPulled_, saveExternal_ ? saveExternal_() : std::any() };
+}
+
+bool Stepper::takesPart(std::size_t i) const
+{
+  return alive_[i] && (!reactions_[i].enabled || reactions_[i].enabled());
 }
 
 void Stepper::restore(const Snapshot& s)
@@ -83,6 +114,11 @@ void Stepper::restore(const Snapshot& s)
   log_.resize(s.logSize);
   processed_.resize(s.processedSize);
   accepted_.resize(s.acceptedSize);
+  // The external state may replace the dependency plan (which resets the relations' validity),
+  // so it goes first.
+  if (restoreExternal_)
+    restoreExternal_(s.external);
+  lastPulled_ = s.lastPulled;
 }
 
 StepContext Stepper::context(
@@ -113,6 +149,12 @@ void Stepper::pull(std::size_t relation, const std::vector<double>& previous, bo
   if (!from || !to)
     return;
   double v = usePrevious ? previous[*from] : params_.value(*from);
+  if (options_.pullChangedOnly)
+  {
+    if (v == lastPulled_[relation])
+      return;
+    lastPulled_[relation] = v;
+  }
   if (r.map)
     v = r.map(v);
   params_.setValue(*to, v);
@@ -131,6 +173,8 @@ bool Stepper::frame(double tNew, double h, double& requested)
     if (nowAlive == alive_[i])
       continue;
     alive_[i] = nowAlive;
+    if (reactions_[i].enabled && !reactions_[i].enabled())
+      continue;
     StepContext c = context(i, tNew, h, rejected, requested);
     auto& fn = nowAlive ? reactions_[i].init : reactions_[i].terminate;
     log_.push_back(reactions_[i].name + (nowAlive ? ".init" : ".terminate"));
@@ -141,7 +185,7 @@ bool Stepper::frame(double tNew, double h, double& requested)
 
   auto update = [&](std::size_t i)
   {
-    if (!alive_[i])
+    if (!takesPart(i))
       return;
     StepContext c = context(i, tNew, h, rejected, requested);
     log_.push_back(reactions_[i].name + ".update");
@@ -169,7 +213,7 @@ bool Stepper::frame(double tNew, double h, double& requested)
       pull(r, previous, false);
       const std::size_t e = graph_.entityIndex(graph_.relations()[r].dependent);
       log_.push_back(graph_.entityName(e) + ".reevaluate");
-      if (entityReaction_[e] && alive_[*entityReaction_[e]] &&
+      if (entityReaction_[e] && takesPart(*entityReaction_[e]) &&
         reactions_[*entityReaction_[e]].reevaluate)
       {
         StepContext c = context(*entityReaction_[e], tNew, h, rejected, requested);
@@ -179,7 +223,7 @@ bool Stepper::frame(double tNew, double h, double& requested)
   params_.evaluate();
 
   for (std::size_t i : reactionOrder_)
-    if (alive_[i])
+    if (takesPart(i))
     {
       StepContext c = context(i, tNew, h, rejected, requested);
       log_.push_back(reactions_[i].name + ".updatePost");
@@ -197,7 +241,7 @@ bool Stepper::frame(double tNew, double h, double& requested)
     for (std::size_t i : reactionOrder_)
     {
       const Reaction& r = reactions_[i];
-      if (!alive_[i] ||
+      if (!takesPart(i) ||
         std::find(r.reactsTo.begin(), r.reactsTo.end(), ev.name) == r.reactsTo.end())
         continue;
       StepContext c = context(i, tNew, h, rejected, requested);
@@ -208,6 +252,28 @@ bool Stepper::frame(double tNew, double h, double& requested)
     processed_.push_back(ev);
   }
   return !rejected;
+}
+
+void Stepper::settle()
+{
+  const Snapshot s = save();
+  double requested = 0.0;
+  bool accepted = false;
+  try
+  {
+    accepted = frame(t_, 0.0, requested);
+  }
+  catch (...)
+  {
+    restore(s);
+    throw;
+  }
+  if (!accepted)
+  {
+    restore(s);
+    throw ModelError("a reaction rejected the time while the model settled at t = " +
+      std::to_string(t_) + " (there is no earlier time to go back to)");
+  }
 }
 
 int Stepper::step(double dt)

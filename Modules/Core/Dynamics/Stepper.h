@@ -41,6 +41,7 @@
 #include "Dynamics/RootFinding.h"
 #include "Dynamics/Time.h"
 
+#include <any>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -96,6 +97,9 @@ struct Reaction
   std::vector<std::string> reactsTo; ///< event names for `react`
   std::function<void(StepContext&)> init, terminate, update, updatePost, reevaluate;
   std::function<void(StepContext&, const Event&)> react;
+  /// While this returns false the reaction takes no part in frames (no init, update, updatePost
+  /// or react), e.g. a cell that is not in the active IC instance. Empty = always.
+  std::function<bool()> enabled;
 };
 
 struct StepperOptions
@@ -103,6 +107,11 @@ struct StepperOptions
   int maxHalvings = 30;
   CyclePolicy cycles = CyclePolicy::PreviousState;
   int maxEventsPerFrame = 10000;
+  /// A relation copies its master's value only when that value differs from the one it copied
+  /// last, i.e. when the relation is invalid (thesis footnote 27: relations are marked valid once
+  /// evaluated). The dependent then keeps what its own reactions wrote while its master is
+  /// unchanged, which a bidirectional pair (Andyhausen's handles) needs. Off: every frame copies.
+  bool pullChangedOnly = false;
 };
 
 class Stepper
@@ -114,6 +123,10 @@ public:
   /// The evaluation order and the value-pulling relations (Dependencies.h).
   void setDependencies(DependencyGraph graph);
   void setOptions(StepperOptions o) { options_ = o; }
+  /// State the callbacks keep outside the parameter table (structural state of a model): `save`
+  /// is called with every snapshot and `restore` when the stepper steps back, so a rejected
+  /// frame or a probe of stepUntil() leaves no trace in it either.
+  void setExternalState(std::function<std::any()> save, std::function<void(const std::any&)> restore);
   /// Queues an event from outside the model.
   void fireEvent(Event e) { queue_.push(std::move(e)); }
 
@@ -131,6 +144,10 @@ public:
 
   /// Advances to time() + dt (dt > 0) and returns the number of accepted frames it took.
   int step(double dt);
+  /// Evaluates one frame at time() without advancing it (dt = 0): every relation is evaluated
+  /// once, so the model starts from a consistent state. A reaction that rejects the time there
+  /// is a ModelError.
+  void settle();
 
   /// Advances by dt unless guard(params, t) reaches 0 inside the step (locateCrossing); then
   /// stops exactly at the located time and returns the crossing. The guard is probed by
@@ -146,6 +163,8 @@ public:
     double t = 0.0;
     std::vector<bool> alive;
     std::size_t logSize = 0, processedSize = 0, acceptedSize = 0;
+    std::vector<double> lastPulled;
+    std::any external;
   };
   Snapshot save() const;
   void restore(const Snapshot& s);
@@ -155,6 +174,7 @@ private:
   StepContext context(
     std::size_t reaction, double tNew, double h, bool& rejected, double& requested);
   void pull(std::size_t relation, const std::vector<double>& previous, bool usePrevious);
+  bool takesPart(std::size_t reaction) const;
 
   ParameterTable params_;
   double t_ = 0.0;
@@ -171,6 +191,9 @@ private:
   std::vector<Event> processed_;
   std::vector<double> accepted_;
   int rejections_ = 0;
+  std::vector<double> lastPulled_; // per relation: the value it copied last (NaN: never)
+  std::function<std::any()> saveExternal_;
+  std::function<void(const std::any&)> restoreExternal_;
 };
 
 } // namespace ictk::dyn

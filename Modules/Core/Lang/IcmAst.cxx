@@ -68,6 +68,18 @@ const Event* Model::event(const std::string& n) const
   return nullptr;
 }
 
+const CellDef* Model::animation(const std::string& n) const
+{
+  for (const CellDef& a : animations)
+  {
+    if (a.name.text == n)
+    {
+      return &a;
+    }
+  }
+  return nullptr;
+}
+
 const std::vector<Builtin>& builtins()
 {
   static const std::vector<Builtin> table = {
@@ -87,7 +99,7 @@ const std::vector<Builtin>& builtins()
     // Shapes computed in reactions (T-cells) and FRep parameters.
     { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" },
     { "arc", 3, 3, "arc(vec3 p, vec3 q, real radius)", "shape" },
-    { "sector", 3, 3, "sector(vec3 p, vec3 q, real radius)", "shape" },
+    { "circularSegment", 3, 3, "circularSegment(vec3 p, vec3 q, real radius)", "shape" },
     { "setShapeParameter", 3, 3, "setShapeParameter(cell, string name, real value)", "void" },
     // Vectors.
     { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" },

@@ -236,6 +236,11 @@ struct Model
   std::vector<ParamDecl> stateParameters, parameters;
   std::vector<Instance> instances; ///< templates and instances, in file order
   std::vector<Procedure> functions;
+  /// `ANIMATIONS { name { keys = {t, x, y, z}, ...; interpolation = linear; ... } }`: named
+  /// animation curves (thesis Table 3) for animation(), animationValue(), animationDuration().
+  std::vector<CellDef> animations;
+  /// `cycles = previous | reevaluate | cut;`: how dependency cycles are evaluated (docs/icm.md).
+  Name cycles;
   // Fragments (notation mode only): sections outside any instance.
   std::vector<RelationsSection> relations;
   std::vector<Procedure> reactions, predicates;
@@ -243,6 +248,7 @@ struct Model
   const CellDef* cell(const std::string& name) const;
   const Instance* instance(const std::string& name) const;
   const Event* event(const std::string& name) const;
+  const CellDef* animation(const std::string& name) const;
 };
 
 /// One function of the built-in library callable from reactions, predicates and functions.

@@ -172,6 +172,17 @@ public:
       declare(events_, e.name, &e, "event");
       event(e);
     }
+    for (const CellDef& a : m_.animations)
+    {
+      declare(animations_, a.name, &a, "animation");
+      animation(a);
+    }
+    if (!m_.cycles.text.empty() && m_.cycles.text != "previous" &&
+      m_.cycles.text != "reevaluate" && m_.cycles.text != "cut")
+    {
+      err(m_.cycles.pos,
+        "unknown cycle policy '" + m_.cycles.text + "' (previous, reevaluate or cut)");
+    }
     for (const CellsSection& s : m_.cells)
     {
       for (const CellDef& c : s.defs)
@@ -255,6 +266,7 @@ private:
   hf::DiagnosticSink& sink_;
   const Limits& limits_;
   std::map<std::string, const Timespan*> timespans_;
+  std::map<std::string, const CellDef*> animations_;
   std::map<std::string, const Event*> events_;
   CellMap globalCells_;
   std::map<std::string, const Instance*> instances_;
@@ -345,6 +357,65 @@ private:
       (intervals > 0 && plain.size() == 1 && plain[0] <= 0))
     {
       err(t.name.pos, "the time scale must be positive");
+    }
+  }
+
+  // keys = {t, v} or {t, x, y, z}, ...; interpolation = step | linear | catmullrom | hermite;
+  // before / after = constant | linear | loop | mirror.
+  void animation(const CellDef& a)
+  {
+    if (!a.parameters.empty() || !a.reactions.empty() || !a.source.text.empty())
+    {
+      err(a.pos, "an animation has only the properties keys, interpolation, before and after");
+    }
+    bool hasKeys = false;
+    for (const Property& p : a.properties)
+    {
+      if (p.name == "keys")
+      {
+        hasKeys = true;
+        std::size_t width = 0;
+        for (const ExprPtr& k : p.values)
+        {
+          if (k->kind != Expr::Kind::Brace || (k->kids.size() != 2 && k->kids.size() != 4))
+          {
+            err(k->pos, "a key is {time, value} or {time, x, y, z}");
+            continue;
+          }
+          if (width != 0 && k->kids.size() != width)
+          {
+            err(k->pos, "every key of an animation has the same number of values");
+          }
+          width = k->kids.size();
+          for (const ExprPtr& v : k->kids)
+          {
+            constant(v);
+          }
+        }
+      }
+      else if (p.name == "interpolation" || p.name == "before" || p.name == "after")
+      {
+        static const std::set<std::string> inKinds = { "step", "linear", "catmullrom", "hermite" };
+        static const std::set<std::string> outKinds = { "constant", "linear", "loop", "mirror" };
+        const auto& kinds = p.name == "interpolation" ? inKinds : outKinds;
+        if (p.values.size() != 1 || p.values[0]->kind != Expr::Kind::Name ||
+          kinds.count(p.values[0]->text) == 0)
+        {
+          err(p.pos, "unknown " + p.name + " (" +
+              (p.name == "interpolation" ? "step, linear, catmullrom or hermite"
+                                         : "constant, linear, loop or mirror") +
+              ")");
+        }
+      }
+      else
+      {
+        err(p.pos, "unknown animation property '" + p.name +
+            "' (keys, interpolation, before, after)");
+      }
+    }
+    if (!hasKeys)
+    {
+      err(a.pos, "the animation '" + a.name.text + "' has no keys");
     }
   }
 
@@ -2223,6 +2294,11 @@ private:
         "'" + fn + "' takes " + arity(*b) + " argument(s) (" + b->signature + "), found " +
           std::to_string(n));
     }
+    if ((fn == "animation" || fn == "animationValue" || fn == "animationDuration") && n >= 1 &&
+      e.kids[1]->kind == Expr::Kind::String && animations_.count(e.kids[1]->text) == 0)
+    {
+      err(e.kids[1]->pos, "undefined animation \"" + e.kids[1]->text + "\"");
+    }
     const std::string sig = b->signature;
     std::size_t first = 1;
     if (fn == "fireEvent" && n >= 1)
@@ -2237,7 +2313,8 @@ private:
       {
         if (n != 2)
         {
-          err(e.pos, "fireEvent(TIME_REJECTED, newTime) takes the time to step back to");
+          err(e.pos, "fireEvent(TIME_REJECTED, step) takes the step to retry with, from the "
+                     "last accepted time");
         }
       }
       else

@@ -287,6 +287,18 @@ private:
       m.name = name("the model name");
       expect(Tok::Semi, "';'");
     }
+    else if (isWord("cycles") && at(1).kind == Tok::Assign)
+    {
+      take();
+      take();
+      m.cycles = name("the cycle policy (previous, reevaluate or cut)");
+      expect(Tok::Semi, "';'");
+    }
+    else if (isWord("ANIMATIONS"))
+    {
+      take();
+      block("ANIMATIONS", [&] { m.animations.push_back(cellDef()); });
+    }
     else if (isWord("TIMESPANS"))
     {
       take();
@@ -352,8 +364,8 @@ private:
     }
     else
     {
-      expected("a section (TIMESPANS, EVENTS, CELLS, ATTRIBUTES, STATE_PARAMETERS, a template, "
-               "an instance or a function)");
+      expected("a section (TIMESPANS, EVENTS, ANIMATIONS, CELLS, ATTRIBUTES, STATE_PARAMETERS, a "
+               "template, an instance or a function)");
     }
   }
 

@@ -1,0 +1,305 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The engine that runs .icm models (Modules/Core/Engine), on the exemplars of thesis ch. 4.4 and 5
+// (Data/Models/icm). Every expected value is derived by hand in the comment next to it.
+#include "Engine/DynamicModel.h"
+#include "Lang/Icm.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace
+{
+
+using ictk::engine::DynamicModel;
+using ictk::engine::FrameRecord;
+using ictk::engine::ModelError;
+using ictk::engine::Value;
+
+const std::string models = std::string(ICTK_DATA_DIR) + "/Models/icm/";
+constexpr double pi = 3.14159265358979323846;
+
+DynamicModel load(const std::string& name)
+{
+  return DynamicModel::load(models + name);
+}
+
+double real(const DynamicModel& m, const std::string& path)
+{
+  const Value v = m.value(path);
+  EXPECT_TRUE(v.isNumber()) << path;
+  return v.number;
+}
+
+const FrameRecord* transitionTo(const std::vector<FrameRecord>& rs, const std::string& instance)
+{
+  for (const FrameRecord& r : rs)
+    if (r.transition && r.instance == instance)
+      return &r;
+  return nullptr;
+}
+
+DynamicModel fromText(const std::string& text)
+{
+  return DynamicModel(ictk::lang::readIcm(text, "test.icm"));
+}
+
+} // namespace
+
+// Thesis 5.1: the disk of radius 1 starts at (-2, 0) with velocity (1, 0); the rectangle's left
+// side is x = 2. Its centre is at x = -2 + t, so the disk touches the side at t = 3 (F = (2, 0))
+// and then cuts it in K, L = (2, -+sqrt(1 - d^2)) with d = 4 - t.
+TEST(EngineExemplars, DiskRectangleInstancesAndTransitions)
+{
+  DynamicModel m = load("ch5_1_disk_rectangle.icm");
+  EXPECT_EQ(m.timeRange().first, 0.0);
+  EXPECT_EQ(m.timeRange().second, 10.0);
+  std::vector<FrameRecord> rs = m.advanceTo(2.5, 0.5);
+  ASSERT_FALSE(rs.empty());
+  EXPECT_EQ(rs.front().instance, "K1");
+  EXPECT_TRUE(rs.front().transition); // the initial instance
+  EXPECT_EQ(m.activeInstance(), "K1");
+  EXPECT_NEAR(real(m, "LHKF.translation.x"), 0.5, 1e-12); // -2 + 2.5
+
+  // A coarse step (0.5 from 2.5 to 3.5) jumps over the tangency; the engine still finds K2.
+  rs = m.advanceTo(3.5, 0.5);
+  const FrameRecord* k2 = transitionTo(rs, "K2");
+  const FrameRecord* k3 = transitionTo(rs, "K3");
+  ASSERT_NE(k2, nullptr);
+  ASSERT_NE(k3, nullptr);
+  EXPECT_NEAR(k2->time, 3.0, 1e-6);
+  EXPECT_NEAR(k3->time, 3.0, 1e-6);
+  EXPECT_LE(k2->time, k3->time);
+  EXPECT_EQ(rs.back().instance, "K3");
+  EXPECT_FALSE(rs.back().transition);
+  EXPECT_EQ(rs.back().time, 3.5);
+  // isIntersection is the active instance's answer after its updatePost.
+  ASSERT_FALSE(k2->state.empty());
+  EXPECT_EQ(k2->state[0].first, "isIntersection");
+  EXPECT_EQ(k2->state[0].second.toJson(), "true");
+}
+
+TEST(EngineExemplars, DiskRectangleTangencyPoint)
+{
+  DynamicModel m = load("ch5_1_disk_rectangle.icm");
+  // Stop right at the tangency: K2's updatePost placed F on the rectangle's side.
+  const auto rs = m.advanceTo(3.2, 0.4);
+  const FrameRecord* k2 = transitionTo(rs, "K2");
+  ASSERT_NE(k2, nullptr);
+  // Re-run to that instant: the model is deterministic.
+  DynamicModel again = load("ch5_1_disk_rectangle.icm");
+  again.advanceTo(k2->time, 0.4);
+  EXPECT_EQ(again.activeInstance(), "K2");
+  const Value f = again.value("F_point.translation");
+  EXPECT_NEAR(f.vec[0], 2.0, 1e-6);
+  EXPECT_NEAR(f.vec[1], 0.0, 1e-3); // a tangency: the point is located to sqrt(tolerance)
+  // K2's complex: the two cells and F, with F on the boundary of both.
+  const auto cells = again.cells();
+  ASSERT_EQ(cells.size(), 3u);
+  EXPECT_EQ(cells[2].name, "F_point");
+}
+
+TEST(EngineExemplars, DiskRectangleHalfDisk)
+{
+  DynamicModel m = load("ch5_1_disk_rectangle.icm");
+  // t = 4: the centre is on the side x = 2, so K = (2, -1), L = (2, 1), the chord is 2 long and
+  // the half-disk KFL inside the rectangle has area pi / 2, its arc length pi.
+  m.advanceTo(4.0, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K3");
+  const Value k = m.value("K_point.translation"), l = m.value("L_point.translation");
+  EXPECT_NEAR(k.vec[0], 2.0, 1e-9);
+  EXPECT_NEAR(k.vec[1], -1.0, 1e-6);
+  EXPECT_NEAR(l.vec[1], 1.0, 1e-6);
+  const Value c = m.value("KL_segment.translation");
+  EXPECT_NEAR(c.vec[0], 2.0, 1e-9);
+  EXPECT_NEAR(c.vec[1], 0.0, 1e-6);
+  ictk::engine::QueryOptions q;
+  for (const auto& cell : m.cells())
+  {
+    if (cell.name == "KFL_half_disk")
+    {
+      EXPECT_NEAR(ictk::engine::measure(*cell.shape, q), pi / 2, 1e-6);
+    }
+  }
+
+  // t = 3.5: d = 0.5, K, L = (2, -+sqrt(0.75)); the circular segment inside has area
+  // acos(0.5) - 0.5 sqrt(0.75) = 0.6141848493.
+  DynamicModel n = load("ch5_1_disk_rectangle.icm");
+  n.advanceTo(3.5, 0.1);
+  EXPECT_NEAR(n.value("L_point.translation").vec[1], std::sqrt(0.75), 1e-9);
+  for (const auto& cell : n.cells())
+  {
+    if (cell.name == "KFL_half_disk")
+    {
+      EXPECT_NEAR(ictk::engine::measure(*cell.shape, q), 0.6141848493, 1e-6);
+    }
+  }
+}
+
+// Thesis 5.2 (numbers in the model's header): O(t) = (0, 1.5 - t), the disk's centre (1, 4.5 - t).
+TEST(EngineExemplars, DependencyFollowsAndInstances)
+{
+  DynamicModel m = load("ch5_2_dependency.icm");
+  const auto rs = m.advanceTo(3.4, 0.1);
+  // The disk follows the segment (hierarchical dependency) at every evaluated time.
+  DynamicModel probe = load("ch5_2_dependency.icm");
+  for (double t : { 0.3, 1.0, 2.0, 2.9, 3.4 })
+  {
+    probe.advanceTo(t, 0.1);
+    const Value o = probe.value("OM.center"), d = probe.value("LHKF.center");
+    EXPECT_NEAR(o.vec[1], 1.5 - t, 1e-12) << t;
+    EXPECT_NEAR(d.vec[0], o.vec[0] + 1.0, 1e-12) << t;
+    EXPECT_NEAR(d.vec[1], o.vec[1] + 3.0, 1e-12) << t;
+  }
+  std::vector<std::pair<std::string, double>> seq;
+  for (const FrameRecord& r : rs)
+    if (r.transition)
+      seq.emplace_back(r.instance, r.time);
+  ASSERT_EQ(seq.size(), 5u);
+  EXPECT_EQ(seq[0].first, "K1");
+  EXPECT_EQ(seq[1].first, "K2");
+  EXPECT_NEAR(seq[1].second, 0.5, 1e-6);
+  EXPECT_EQ(seq[2].first, "K3");
+  EXPECT_NEAR(seq[2].second, 2.5, 1e-6);
+  EXPECT_EQ(seq[3].first, "K4"); // the tangency at t = 3, an instant
+  EXPECT_NEAR(seq[3].second, 3.0, 1e-6);
+  EXPECT_EQ(seq[4].first, "K5");
+  EXPECT_NEAR(seq[4].second, 3.0, 1e-6);
+  // In K5 at t = 3.4 the segment meets the rectangle at (0, 1) and (0, -1); the order puts OM
+  // before the disk it carries.
+  const auto order = m.evaluationOrder();
+  std::size_t om = 99, disk = 99;
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (const std::string& n : order[i])
+    {
+      if (n == "OM")
+        om = i;
+      if (n == "LHKF")
+        disk = i;
+    }
+  EXPECT_LT(om, disk);
+}
+
+// Thesis 4.4.1: radius 0.5, B1 from x = -1.5 at speed 1, B2 at rest at x = 0; they touch when the
+// centres are 1 apart, at t = 0.5; the velocities swap, B1 rests at x = -1 and B2 moves on.
+TEST(EngineExemplars, NewtonsCradleSwapsVelocities)
+{
+  DynamicModel m = load("newtons_cradle.icm");
+  const auto rs = m.advanceTo(1.0, 0.1);
+  const FrameRecord* contact = transitionTo(rs, "CONTACT");
+  ASSERT_NE(contact, nullptr);
+  EXPECT_NEAR(contact->time, 0.5, 1e-6);
+  ASSERT_EQ(contact->events.size(), 1u);
+  EXPECT_EQ(contact->events[0], "COLLISION");
+  EXPECT_EQ(m.activeInstance(), "APART");
+  EXPECT_NEAR(real(m, "B1.v"), 0.0, 1e-12);
+  EXPECT_NEAR(real(m, "B2.v"), 1.0, 1e-12);
+  EXPECT_NEAR(real(m, "B1.translation.x"), -1.0, 1e-6);
+  EXPECT_NEAR(real(m, "B2.translation.x"), 0.5, 1e-6);
+  EXPECT_EQ(m.value("collisions").number, 1.0);
+}
+
+// Thesis 5.6 with the model's numbers: alpha(t) = 12 - 2t, hook at y = -0.6 - 0.4t, contact with
+// the liquid at t = 3, the shell under the surface at t = 6.346875, then ANDY_OUT.
+TEST(EngineExemplars, AndyhausenChainOrderAndInstances)
+{
+  DynamicModel m = load("andyhausen.icm");
+  auto rs = m.advanceTo(1.0, 0.1);
+  EXPECT_EQ(m.activeInstance(), "EGG_GOING_DOWN");
+  // The bidirectional dependency keeps the handles together and the chain follows.
+  EXPECT_NEAR(real(m, "Handle1.alpha"), 10.0, 1e-9);
+  EXPECT_NEAR(real(m, "Handle2.alpha"), 10.0, 1e-9);
+  EXPECT_NEAR(real(m, "Barrel.alpha"), 10.0, 1e-9);
+  EXPECT_NEAR(real(m, "Rope.inactiveLength"), 2.0, 1e-9);
+  EXPECT_NEAR(m.value("Hook.translation").vec[1], -1.0, 1e-9);
+  EXPECT_NEAR(m.value("Eggshell.center").vec[1], -1.7, 1e-9);
+  // Footnote 27: Handle1, Barrel, Handle2, then Handle1 again (the cut relation re-evaluated),
+  // in the last frame (after the instance's own update, which drives the handle).
+  const auto& log = m.log();
+  const auto frame = std::find(log.rbegin(), log.rend(), "EGG_GOING_DOWN.update").base();
+  std::vector<std::string> order;
+  for (auto it = frame; it != log.end(); ++it)
+  {
+    const bool chain = it->rfind("Handle", 0) == 0 || it->rfind("Barrel", 0) == 0;
+    const bool update = it->size() > 7 && it->compare(it->size() - 7, 7, ".update") == 0;
+    if (chain && (update || it->find(".reevaluate") != std::string::npos))
+      order.push_back(*it);
+  }
+  const std::vector<std::string> expected = { "Handle1.update", "Barrel.update",
+    "Handle2.update", "Handle1.reevaluate" };
+  EXPECT_EQ(order, expected);
+
+  rs = m.advanceTo(8.0, 0.25);
+  const FrameRecord* eroding = transitionTo(rs, "EGG_ERODING");
+  const FrameRecord* out = transitionTo(rs, "ANDY_OUT");
+  ASSERT_NE(eroding, nullptr);
+  ASSERT_NE(out, nullptr);
+  EXPECT_NEAR(eroding->time, 3.0, 1e-6);
+  EXPECT_NEAR(out->time, 6.346875, 1e-5);
+  EXPECT_EQ(m.activeInstance(), "ANDY_OUT");
+}
+
+TEST(EngineExemplars, Deterministic)
+{
+  auto run = []
+  {
+    DynamicModel m = load("andyhausen.icm");
+    std::string trace;
+    for (const FrameRecord& r : m.advanceTo(7.0, 0.5))
+    {
+      trace += r.instance + "@" + std::to_string(r.time);
+      for (const auto& [n, v] : r.state)
+        trace += " " + n + "=" + v.toJson();
+      trace += "\n";
+    }
+    return trace;
+  };
+  EXPECT_EQ(run(), run());
+}
+
+TEST(EngineErrors, NoValidInstanceNamesTheTime)
+{
+  const std::string text = "CELLS { A { type = F-CELL; shape = disk(1); dim = 2D;\n"
+                           "  parameters { v : REAL(1); }\n"
+                           "  REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) { "
+                           "translation.x += v * dt; } } } }\n"
+                           "K : TEMPLATE_IC { CELLS { A; } }\n"
+                           "ONE : K { PREDICATE { bool evaluate(REAL g, REAL l, REAL dt) { "
+                           "return A.translation.x < 1.0; } } }\n";
+  DynamicModel m = fromText(text);
+  try
+  {
+    m.advanceTo(2.0, 0.5);
+    FAIL() << "expected a ModelError";
+  }
+  catch (const ModelError& e)
+  {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no instance is valid"), std::string::npos) << what;
+    EXPECT_NE(what.find("t = 1.0"), std::string::npos) << what;
+  }
+}
+
+TEST(EngineErrors, RuntimeErrorsHaveThePlace)
+{
+  // Line 3, column 60: the division makes x NaN.
+  const std::string text = "CELLS { A { type = F-CELL; shape = disk(1); dim = 2D;\n"
+                           "  parameters { x : REAL(0); }\n"
+                           "  REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) { x = 0.0 / "
+                           "0.0; } } } }\n"
+                           "K : TEMPLATE_IC { CELLS { A; } }\nONE : K { }\n";
+  DynamicModel m = fromText(text);
+  try
+  {
+    m.advanceTo(1.0, 0.5);
+    FAIL() << "expected a ModelError";
+  }
+  catch (const ModelError& e)
+  {
+    EXPECT_EQ(e.file, "test.icm");
+    EXPECT_EQ(e.pos.line, 3);
+    EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos) << e.what();
+  }
+}
