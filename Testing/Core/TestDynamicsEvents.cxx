@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <any>
 #include <cmath>
 
 using namespace ictk::dyn;
@@ -279,4 +280,114 @@ TEST(DynamicsRootFinding, StepperStopsAtTheCrossing)
   // The next step has no crossing and ends at 3.4.
   EXPECT_FALSE(s.stepUntil(0.4 - (c->time - 2.8), gap));
   EXPECT_NEAR(s.time(), 3.2, 1e-12);
+}
+
+// Structural state outside the parameter table rides along in snapshots: a frame rejected once
+// leaves no trace in it (the external counter sees 4 accepted frames, not 6 attempts).
+TEST(DynamicsStepper, ExternalStateIsRestoredWithTheFrame)
+{
+  ParameterTable p;
+  p.add("A", "x", Scope::Global, 0.0);
+  Stepper s(p);
+  int frames = 0;
+  bool rejectOnce = true;
+  s.setExternalState(
+    [&] { return std::any(frames); }, [&](const std::any& a) { frames = std::any_cast<int>(a); });
+  Reaction r;
+  r.name = "A";
+  r.update = [&](StepContext& c)
+  {
+    ++frames;
+    if (rejectOnce)
+    {
+      rejectOnce = false; // outside the snapshot on purpose: reject only the first attempt
+      c.rejectTime();
+    }
+  };
+  s.addReaction(r);
+  // h = 1 rejected, then 0.5 twice... the first attempt at 1 is rolled back, 0.5 + 0.5 accepted.
+  EXPECT_EQ(s.step(1.0), 2);
+  EXPECT_EQ(frames, 2);
+}
+
+// A disabled reaction takes no part: no update, no log entry, no event.
+TEST(DynamicsStepper, DisabledReactionsAreSkipped)
+{
+  ParameterTable p;
+  p.add("A", "n", Scope::Global, 0.0);
+  Stepper s(p);
+  bool on = false;
+  Reaction r;
+  r.name = "A";
+  r.enabled = [&]
+  {
+    return on;
+  };
+  r.update = [](StepContext& c)
+  {
+    c.set("A.n", c.get("A.n") + 1);
+  };
+  s.addReaction(r);
+  s.step(1.0);
+  EXPECT_EQ(s.params().value("A.n"), 0.0);
+  EXPECT_TRUE(s.log().empty());
+  on = true;
+  s.step(1.0);
+  EXPECT_EQ(s.params().value("A.n"), 1.0);
+}
+
+// Thesis footnote 27: with pullChangedOnly a relation copies only when its master changed, so a
+// dependent may drive its own value while the master rests; a plain pull copies every frame.
+TEST(DynamicsStepper, RelationsCopyOnlyWhenInvalid)
+{
+  auto run = [](bool changedOnly)
+  {
+    ParameterTable p;
+    p.add("M", "v", Scope::Global, 1.0);
+    p.add("D", "v", Scope::Global, 1.0);
+    Stepper s(p);
+    StepperOptions o;
+    o.pullChangedOnly = changedOnly;
+    s.setOptions(o);
+    Reaction d;
+    d.name = "D";
+    d.update = [](StepContext& c)
+    {
+      c.set("D.v", c.get("D.v") + 10);
+    };
+    s.addReaction(d);
+    DependencyGraph g;
+    g.addRelation("M.v", "D.v");
+    s.setDependencies(g);
+    s.step(1.0); // first frame: the new relation is invalid, copies 1, then D adds 10: 11
+    s.step(1.0); // M unchanged: the relation stays valid (21) or copies again (11)
+    return s.params().value("D.v");
+  };
+  EXPECT_EQ(run(true), 21.0);
+  EXPECT_EQ(run(false), 11.0);
+}
+
+// settle() evaluates one frame at the current time: relations and updates with dt = 0.
+TEST(DynamicsStepper, SettleEvaluatesAFrameWithoutTime)
+{
+  ParameterTable p;
+  p.add("M", "v", Scope::Global, 3.0);
+  p.add("D", "v", Scope::Global, 0.0);
+  Stepper s(p, 2.0);
+  Reaction d;
+  d.name = "D";
+  double seenDt = -1.0;
+  d.update = [&](StepContext& c)
+  {
+    seenDt = c.dt;
+  };
+  s.addReaction(d);
+  DependencyGraph g;
+  g.addRelation("M.v", "D.v");
+  s.setDependencies(g);
+  s.settle();
+  EXPECT_EQ(s.time(), 2.0);
+  EXPECT_EQ(s.params().value("D.v"), 3.0);
+  EXPECT_EQ(seenDt, 0.0);
+  EXPECT_TRUE(s.acceptedTimes().empty());
 }

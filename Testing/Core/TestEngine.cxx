@@ -227,8 +227,8 @@ TEST(EngineExemplars, AndyhausenChainOrderAndInstances)
     if (chain && (update || it->find(".reevaluate") != std::string::npos))
       order.push_back(*it);
   }
-  const std::vector<std::string> expected = { "Handle1.update", "Barrel.update",
-    "Handle2.update", "Handle1.reevaluate" };
+  const std::vector<std::string> expected = { "Handle1.update", "Barrel.update", "Handle2.update",
+    "Handle1.reevaluate" };
   EXPECT_EQ(order, expected);
 
   rs = m.advanceTo(8.0, 0.25);
@@ -301,5 +301,64 @@ TEST(EngineErrors, RuntimeErrorsHaveThePlace)
     EXPECT_EQ(e.file, "test.icm");
     EXPECT_EQ(e.pos.line, 3);
     EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos) << e.what();
+  }
+}
+
+// The imperative core through a model: a function, a bounded loop, relative assignment on
+// vectors and components, if/else, integer and real arithmetic, animation curves.
+TEST(EngineInterpreter, CoreConstructs)
+{
+  const std::string text =
+    "ANIMATIONS { ramp { keys = { 0, 0 }, { 2, 4 }; }\n"
+    "  path { keys = { 0, 0, 0, 0 }, { 1, 1, 2, 3 }; } }\n"
+    "function sumTo(int n) { int s = 0; for i in 0..n { s += i; } "
+    "return s; }\n"
+    "STATE_PARAMETERS { total : INT(0); ratio : REAL(0); w : VECTOR3(1, 2, 3); "
+    "flag : BOOL(false); }\n"
+    "CELLS { A { type = F-CELL; shape = disk(1); dim = 2D; } }\n"
+    "K : TEMPLATE_IC { CELLS { A; } }\n"
+    "ONE : K { REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) {\n"
+    "  total = sumTo(5);\n"                     // 0+1+2+3+4 = 10
+    "  ratio = 7 / 2;\n"                        // real division: 3.5
+    "  w *= 2; w.y += 1; w -= vec3(1, 1, 1);\n" // (2,4,6) -> (2,5,6) -> (1,4,5)
+    "  if (length(w) > 6.0) { flag = true; } else { flag = false; }\n"
+    "  A.translation = animation(\"path\", 0.5) + vec3(0, 0, animationValue(\"ramp\", 1));\n"
+    "} } }\n";
+  DynamicModel m = fromText(text);
+  m.advanceTo(0.1, 0.1);
+  EXPECT_EQ(m.value("total").number, 10.0);
+  EXPECT_EQ(m.value("total").type, Value::Type::Int);
+  EXPECT_EQ(m.value("ratio").number, 3.5);
+  const Value w = m.value("w");
+  // Two frames ran (settle at 0 and the step to 0.1): (1,2,3) -> (1,4,5) -> (1,8,9).
+  EXPECT_EQ(w.vec[0], 1.0);
+  EXPECT_EQ(w.vec[1], 8.0);
+  EXPECT_EQ(w.vec[2], 9.0);
+  EXPECT_EQ(m.value("flag").toJson(), "true"); // |(1,8,9)| = 12.08 > 6
+  // path at 0.5: (0.5, 1, 1.5); ramp at 1: 2.
+  const Value t = m.value("A.translation");
+  EXPECT_DOUBLE_EQ(t.vec[0], 0.5);
+  EXPECT_DOUBLE_EQ(t.vec[1], 1.0);
+  EXPECT_DOUBLE_EQ(t.vec[2], 3.5);
+}
+
+TEST(EngineInterpreter, TypeErrorsAtRunTime)
+{
+  // A BOOL state parameter assigned a number: caught where it happens (line 4).
+  const std::string text =
+    "STATE_PARAMETERS { flag : BOOL(false); }\n"
+    "CELLS { A { type = F-CELL; shape = disk(1); dim = 2D; } }\n"
+    "K : TEMPLATE_IC { CELLS { A; } }\n"
+    "ONE : K { REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) { flag = g; } } }\n";
+  DynamicModel m = fromText(text);
+  try
+  {
+    m.advanceTo(1.0, 0.5);
+    FAIL() << "expected a ModelError";
+  }
+  catch (const ModelError& e)
+  {
+    EXPECT_EQ(e.pos.line, 4);
+    EXPECT_NE(std::string(e.what()).find("flag is a bool"), std::string::npos) << e.what();
   }
 }

@@ -686,8 +686,7 @@ TEST(IcmDiagnostics, LineColumnAndMessage)
     { "animation interpolation", "ANIMATIONS { a { keys = { 0, 1 }; interpolation = cubic; } }",
       "1:35: error: unknown interpolation (step, linear, catmullrom or hermite)" },
     { "undefined animation",
-      header + t +
-        "K : T { REACTIONS { init(REAL g) { A.p = animationValue(\"walk\", g); } } }",
+      header + t + "K : T { REACTIONS { init(REAL g) { A.p = animationValue(\"walk\", g); } } }",
       "3:57: error: undefined animation \"walk\"" },
     { "cycle policy", "cycles = sometimes;", "1:10: error: unknown cycle policy 'sometimes'" },
     { "self dependency", header + t + "K : T { RELATIONS { dependency { A.p A.p; } } }",

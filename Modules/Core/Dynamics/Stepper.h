@@ -126,7 +126,8 @@ public:
   /// State the callbacks keep outside the parameter table (structural state of a model): `save`
   /// is called with every snapshot and `restore` when the stepper steps back, so a rejected
   /// frame or a probe of stepUntil() leaves no trace in it either.
-  void setExternalState(std::function<std::any()> save, std::function<void(const std::any&)> restore);
+  void setExternalState(
+    std::function<std::any()> save, std::function<void(const std::any&)> restore);
   /// Queues an event from outside the model.
   void fireEvent(Event e) { queue_.push(std::move(e)); }
 

@@ -100,7 +100,7 @@ struct InstanceSpec
   bool isTemplate = false;
   std::vector<std::string> cells;
   std::vector<RelationSpec> boundary, containment, dependency;
-  std::vector<ParamSpec> params; ///< instance parameters and typed state parameters
+  std::vector<ParamSpec> params;       ///< instance parameters and typed state parameters
   std::vector<std::string> stateNames; ///< typed state parameters and aliases, in order
   std::vector<AliasSpec> aliases;
   std::map<std::string, const Procedure*> reactions;
@@ -230,7 +230,8 @@ struct DynamicModel::Impl
   void buildShape(CellSpec& c, const Property& p);
   void buildInstance(const Instance& in);
   std::vector<std::string> cellsOf(const Instance& in, int depth) const;
-  std::vector<RelationSpec> relationsOf(const Instance& in, const std::string& kind, int depth) const;
+  std::vector<RelationSpec> relationsOf(
+    const Instance& in, const std::string& kind, int depth) const;
   RelationSpec relationSpec(const Relation& r, bool dependency) const;
   void addParam(const std::string& owner, const ParamSpec& p);
   void buildStepper();
@@ -264,8 +265,8 @@ struct DynamicModel::Impl
   const Procedure* procedureFor(const std::string& cell, const std::string& key) const;
   void runCell(const std::string& cell, const std::string& key, dyn::StepContext& c,
     const dyn::Event* ev = nullptr);
-  void runInstance(std::size_t i, const std::string& key, dyn::StepContext& c,
-    const dyn::Event* ev = nullptr);
+  void runInstance(
+    std::size_t i, const std::string& key, dyn::StepContext& c, const dyn::Event* ev = nullptr);
   void activate(dyn::StepContext& c);
   std::vector<std::size_t> validInstances(double t);
   void setActive(std::size_t i, double t);
@@ -473,7 +474,7 @@ void DynamicModel::Impl::buildAnimations()
       {
         const std::string& t = p.values[0]->text;
         if (p.name == "interpolation")
-          in = t == "step"   ? dyn::Interpolation::Step
+          in = t == "step"      ? dyn::Interpolation::Step
             : t == "catmullrom" ? dyn::Interpolation::CatmullRom
             : t == "hermite"    ? dyn::Interpolation::Hermite
                                 : dyn::Interpolation::Linear;
@@ -637,8 +638,7 @@ void DynamicModel::Impl::buildCell(const CellDef& def)
         spec.initial = Value{}; // arrays and transforms: they order dependencies only
       else
       {
-        const Value v =
-          p.args.empty() ? Value::real(0.0) : interpreter.evaluate(*p.args[0], scope);
+        const Value v = p.args.empty() ? Value::real(0.0) : interpreter.evaluate(*p.args[0], scope);
         spec.initial = t == Value::Type::Real ? Value::real(v.number)
           : t == Value::Type::Int             ? Value::integer(v.number)
           : t == Value::Type::Bool            ? Value::boolean(v.number != 0.0)
@@ -787,9 +787,9 @@ void DynamicModel::Impl::buildShape(CellSpec& c, const Property& p)
     {
       if (args.size() < 2 || args[0].type != Value::Type::Cell || args[1].type != Value::Type::Cell)
         fail(v->pos, f + " takes two cells");
-      c.operands = CellSpec::Operands{ f == "blend" ? ShapePart::Kind::Blend
-                                                    : ShapePart::Kind::Union,
-        args[0].text, args[1].text, f == "blend" ? num(2) : 0.0 };
+      c.operands =
+        CellSpec::Operands{ f == "blend" ? ShapePart::Kind::Blend : ShapePart::Kind::Union,
+          args[0].text, args[1].text, f == "blend" ? num(2) : 0.0 };
       continue;
     }
     else
@@ -1033,8 +1033,8 @@ dyn::DependencyGraph DynamicModel::Impl::graph(std::size_t i) const
     }
     const std::string mq = qualified(r.master, r.masterMember);
     const std::string dq = qualified(r.dependent, r.dependentMember);
-    const bool bothParams = !r.masterMember.empty() && !r.dependentMember.empty() &&
-      hasParam(mq) && hasParam(dq);
+    const bool bothParams =
+      !r.masterMember.empty() && !r.dependentMember.empty() && hasParam(mq) && hasParam(dq);
     if (bothParams)
     {
       const Value::Type a = types.at(mq), b = types.at(dq);
@@ -1053,8 +1053,10 @@ dyn::DependencyGraph DynamicModel::Impl::graph(std::size_t i) const
         continue;
       }
       if (!numbers)
-        fail(r.pos, "the dependency " + mq + " -> " + dq + " connects a " + typeName(a) +
-            " to a " + typeName(b) + "; name a component (" + mq + ".x) or a parameter of the "
+        fail(r.pos,
+          "the dependency " + mq + " -> " + dq + " connects a " + typeName(a) + " to a " +
+            typeName(b) + "; name a component (" + mq +
+            ".x) or a parameter of the "
             "same type");
       d.masterParam = r.masterMember;
       d.dependentParam = r.dependentMember;
@@ -1087,15 +1089,32 @@ void DynamicModel::Impl::buildStepper()
             if (key.rfind("react:", 0) == 0)
               r.reactsTo.push_back(key.substr(6));
     const std::string n = c.name;
-    r.enabled = [this, n] { return present(n); };
-    r.update = [this, n](dyn::StepContext& ctx) { runCell(n, "update", ctx); };
-    r.updatePost = [this, n](dyn::StepContext& ctx) { runCell(n, "updatePost", ctx); };
-    r.init = [this, n](dyn::StepContext& ctx) { runCell(n, "init", ctx); };
-    r.terminate = [this, n](dyn::StepContext& ctx) { runCell(n, "terminate", ctx); };
+    r.enabled = [this, n]
+    {
+      return present(n);
+    };
+    r.update = [this, n](dyn::StepContext& ctx)
+    {
+      runCell(n, "update", ctx);
+    };
+    r.updatePost = [this, n](dyn::StepContext& ctx)
+    {
+      runCell(n, "updatePost", ctx);
+    };
+    r.init = [this, n](dyn::StepContext& ctx)
+    {
+      runCell(n, "init", ctx);
+    };
+    r.terminate = [this, n](dyn::StepContext& ctx)
+    {
+      runCell(n, "terminate", ctx);
+    };
     // Re-evaluation (CyclePolicy::Reevaluate) pulls the cut relation again; it does not re-run
     // the cell's update, which would integrate twice (translation += v * dt).
     r.react = [this, n](dyn::StepContext& ctx, const dyn::Event& e)
-    { runCell(n, "react:" + e.name, ctx, &e); };
+    {
+      runCell(n, "react:" + e.name, ctx, &e);
+    };
     stepper->addReaction(std::move(r));
   }
   for (std::size_t i = 0; i < instances.size(); ++i)
@@ -1105,15 +1124,23 @@ void DynamicModel::Impl::buildStepper()
     dyn::Reaction r;
     r.name = instances[i].name;
     r.reactsTo.assign(instances[i].reactsTo.begin(), instances[i].reactsTo.end());
-    r.enabled = [this, i] { return s.active == i; };
+    r.enabled = [this, i]
+    {
+      return s.active == i;
+    };
     r.update = [this, i](dyn::StepContext& ctx)
     {
       activate(ctx);
       runInstance(i, "update", ctx);
     };
-    r.updatePost = [this, i](dyn::StepContext& ctx) { runInstance(i, "updatePost", ctx); };
+    r.updatePost = [this, i](dyn::StepContext& ctx)
+    {
+      runInstance(i, "updatePost", ctx);
+    };
     r.react = [this, i](dyn::StepContext& ctx, const dyn::Event& e)
-    { runInstance(i, "react:" + e.name, ctx, &e); };
+    {
+      runInstance(i, "react:" + e.name, ctx, &e);
+    };
     stepper->addReaction(std::move(r));
   }
   stepper->setExternalState([this] { return std::any(s); },
@@ -1418,8 +1445,8 @@ std::vector<std::size_t> DynamicModel::Impl::validInstances(double t)
     const Value r = interpreter.run(
       *in.predicate, timeArgs(*in.predicate, t, local, local, 0.0, nullptr, eventParams), scope);
     if (r.type != Value::Type::Bool)
-      fail(in.predicate->pos, "the predicate of " + in.name + " returned a " + typeName(r.type) +
-          ", not a bool");
+      fail(in.predicate->pos,
+        "the predicate of " + in.name + " returned a " + typeName(r.type) + ", not a bool");
     if (r.number != 0.0)
       valid.push_back(i);
   }
@@ -1668,8 +1695,7 @@ Value EngineScope::call(const std::string& name, const std::vector<Value>& args)
     return Value::vector(pts[static_cast<std::size_t>(i)]);
   }
   if (name == "intersectionArea")
-    return Value::real(
-      intersectionMeasure(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
+    return Value::real(intersectionMeasure(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
   if (name == "segment" || name == "arc" || name == "circularSegment")
   {
     ShapePart p;
@@ -1863,8 +1889,8 @@ FrameRecord DynamicModel::start()
     if (now == chosen)
       break;
     if (attempt > 16)
-      m.fail(m.instances[chosen].pos, "no instance stays valid when the model settles at t = " +
-          std::to_string(t));
+      m.fail(m.instances[chosen].pos,
+        "no instance stays valid when the model settles at t = " + std::to_string(t));
     chosen = now;
   }
   return m.record(t, true);
@@ -1928,8 +1954,8 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
           std::string names;
           for (std::size_t i : valid)
             names += (names.empty() ? "" : ", ") + m.instances[i].name;
-          m.fail({ 1, 1 }, "at t = " + std::to_string(hi) + " after " +
-              m.instances[m.s.active].name + ", " +
+          m.fail({ 1, 1 },
+            "at t = " + std::to_string(hi) + " after " + m.instances[m.s.active].name + ", " +
               (valid.empty() ? std::string("no instance is valid")
                              : "several instances are valid: " + names) +
               " (exactly one must be, thesis L1394)");
@@ -1937,8 +1963,8 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
         if (valid[0] == m.s.active)
           break;
         if (hop > 16)
-          m.fail({ 1, 1 }, "at t = " + std::to_string(hi) +
-              " the instances keep switching without time passing");
+          m.fail({ 1, 1 },
+            "at t = " + std::to_string(hi) + " the instances keep switching without time passing");
         const std::size_t next = valid[0];
         if (hop == 0)
         {

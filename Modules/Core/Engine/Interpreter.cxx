@@ -281,14 +281,14 @@ Value Interpreter::eval(const Expr& e, Frame& f) const
         fail(e.pos, x.what());
       }
       fail(e.pos,
-        base.type == Value::Type::Cell ? "the cell " + base.text + " has no parameter or property '" +
-            e.text + "'"
-                                       : std::string("a ") + typeName(base.type) +
-            " has no member '" + e.text + "'");
+        base.type == Value::Type::Cell
+          ? "the cell " + base.text + " has no parameter or property '" + e.text + "'"
+          : std::string("a ") + typeName(base.type) + " has no member '" + e.text + "'");
     }
     case Expr::Kind::Index:
-      fail(e.pos, "indexed parameters (arrays) cannot be read in code; they only order "
-                  "dependencies");
+      fail(e.pos,
+        "indexed parameters (arrays) cannot be read in code; they only order "
+        "dependencies");
     case Expr::Kind::Call:
     {
       std::vector<Value> args;
@@ -313,11 +313,10 @@ Value Interpreter::eval(const Expr& e, Frame& f) const
         return Value::boolean(v.number == 0.0);
       }
       if (v.type == Value::Type::Vec3)
-        return Value::vector(
-          e.text == "-" ? Vec3{ -v.vec[0], -v.vec[1], -v.vec[2] } : v.vec);
+        return Value::vector(e.text == "-" ? Vec3{ -v.vec[0], -v.vec[1], -v.vec[2] } : v.vec);
       if (!v.isNumber())
-        fail(e.pos, std::string("'") + e.text + "' needs a number or a vec3, not a " +
-            typeName(v.type));
+        fail(e.pos,
+          std::string("'") + e.text + "' needs a number or a vec3, not a " + typeName(v.type));
       Value r = v;
       if (e.text == "-")
         r.number = -r.number;
@@ -347,18 +346,18 @@ Value Interpreter::eval(const Expr& e, Frame& f) const
           (b.isNumber() || b.type == Value::Type::Bool) &&
           (a.type == Value::Type::Bool) == (b.type == Value::Type::Bool))
           equal = a.number == b.number;
-        else if ((a.type == Value::Type::String || a.type == Value::Type::Cell) &&
-          a.type == b.type)
+        else if ((a.type == Value::Type::String || a.type == Value::Type::Cell) && a.type == b.type)
           equal = a.text == b.text;
         else
-          fail(e.pos, std::string("cannot compare a ") + typeName(a.type) + " with a " +
-              typeName(b.type));
+          fail(e.pos,
+            std::string("cannot compare a ") + typeName(a.type) + " with a " + typeName(b.type));
         return Value::boolean((op == "==") == equal);
       }
       if (op == "<" || op == "<=" || op == ">" || op == ">=")
       {
         if (!a.isNumber() || !b.isNumber())
-          fail(e.pos, "'" + op + "' compares numbers, not a " + typeName(a.type) + " and a " +
+          fail(e.pos,
+            "'" + op + "' compares numbers, not a " + typeName(a.type) + " and a " +
               typeName(b.type));
         const double x = a.number, y = b.number;
         return Value::boolean(op == "<" ? x < y : op == "<=" ? x <= y : op == ">" ? x > y : x >= y);
@@ -378,13 +377,15 @@ Value Interpreter::eval(const Expr& e, Frame& f) const
           return Value::vector({ b.vec[0] * a.number, b.vec[1] * a.number, b.vec[2] * a.number });
         if (op == "/" && a.type == Value::Type::Vec3 && b.isNumber())
           return Value::vector({ a.vec[0] / b.number, a.vec[1] / b.number, a.vec[2] / b.number });
-        fail(e.pos, std::string("cannot apply '") + op + "' to a " + typeName(a.type) + " and a " +
+        fail(e.pos,
+          std::string("cannot apply '") + op + "' to a " + typeName(a.type) + " and a " +
             typeName(b.type));
       }
       if (op == "+" && a.type == Value::Type::String && b.type == Value::Type::String)
         return Value::string(a.text + b.text);
       if (!a.isNumber() || !b.isNumber())
-        fail(e.pos, std::string("cannot apply '") + op + "' to a " + typeName(a.type) + " and a " +
+        fail(e.pos,
+          std::string("cannot apply '") + op + "' to a " + typeName(a.type) + " and a " +
             typeName(b.type));
       const bool ints = a.type == Value::Type::Int && b.type == Value::Type::Int;
       double r = 0.0;
@@ -427,35 +428,77 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
     bool ok = false;
     const double v = asNumber(args.at(i), ok);
     if (!ok || args[i].type == Value::Type::Bool)
-      fail(call.kids[i + 1]->pos, "argument " + std::to_string(i + 1) + " of " + name +
-          " must be a number, not a " + typeName(args[i].type));
+      fail(call.kids[i + 1]->pos,
+        "argument " + std::to_string(i + 1) + " of " + name + " must be a number, not a " +
+          typeName(args[i].type));
     return v;
   };
   auto vec = [&](std::size_t i)
   {
     if (args.at(i).type != Value::Type::Vec3)
-      fail(call.kids[i + 1]->pos, "argument " + std::to_string(i + 1) + " of " + name +
-          " must be a vec3, not a " + typeName(args[i].type));
+      fail(call.kids[i + 1]->pos,
+        "argument " + std::to_string(i + 1) + " of " + name + " must be a vec3, not a " +
+          typeName(args[i].type));
     return args[i].vec;
   };
   auto arity = [&](std::size_t n)
   {
     if (args.size() != n)
-      fail(call.pos, name + " takes " + std::to_string(n) + " argument(s), got " +
-          std::to_string(args.size()));
+      fail(call.pos,
+        name + " takes " + std::to_string(n) + " argument(s), got " + std::to_string(args.size()));
   };
   using Unary = double (*)(double);
   static const std::map<std::string, Unary> unary = {
-    { "abs", [](double x) { return std::fabs(x); } },
-    { "sqrt", [](double x) { return std::sqrt(x); } },
-    { "sin", [](double x) { return std::sin(x); } },
-    { "cos", [](double x) { return std::cos(x); } },
-    { "tan", [](double x) { return std::tan(x); } },
-    { "asin", [](double x) { return std::asin(x); } },
-    { "acos", [](double x) { return std::acos(x); } },
-    { "atan", [](double x) { return std::atan(x); } },
-    { "exp", [](double x) { return std::exp(x); } },
-    { "log", [](double x) { return std::log(x); } },
+    { "abs",
+      [](double x)
+      {
+        return std::fabs(x);
+      } },
+    { "sqrt",
+      [](double x)
+      {
+        return std::sqrt(x);
+      } },
+    { "sin",
+      [](double x)
+      {
+        return std::sin(x);
+      } },
+    { "cos",
+      [](double x)
+      {
+        return std::cos(x);
+      } },
+    { "tan",
+      [](double x)
+      {
+        return std::tan(x);
+      } },
+    { "asin",
+      [](double x)
+      {
+        return std::asin(x);
+      } },
+    { "acos",
+      [](double x)
+      {
+        return std::acos(x);
+      } },
+    { "atan",
+      [](double x)
+      {
+        return std::atan(x);
+      } },
+    { "exp",
+      [](double x)
+      {
+        return std::exp(x);
+      } },
+    { "log",
+      [](double x)
+      {
+        return std::log(x);
+      } },
   };
   if (auto it = unary.find(name); it != unary.end())
   {
@@ -517,8 +560,9 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
       if (p.name.text == name)
       {
         if (args.size() != p.formals.size())
-          fail(call.pos, name + " takes " + std::to_string(p.formals.size()) +
-              " argument(s), got " + std::to_string(args.size()));
+          fail(call.pos,
+            name + " takes " + std::to_string(p.formals.size()) + " argument(s), got " +
+              std::to_string(args.size()));
         // The checker allows calls only to earlier functions, so the depth is bounded by the
         // number of functions; the guard protects models built without the checker.
         if (f.depth > static_cast<int>(functions_->size()))
@@ -578,8 +622,8 @@ bool Interpreter::exec(const Stmt& s, Frame& f) const
       else if (want == Value::Type::Int && v.isNumber())
         v = Value::integer(v.number);
       else if (want != Value::Type::None && v.type != want)
-        fail(s.pos, "'" + s.name + "' is a " + t + " but is initialised with a " +
-            typeName(v.type));
+        fail(
+          s.pos, "'" + s.name + "' is a " + t + " but is initialised with a " + typeName(v.type));
       f.locals[s.name] = v;
       return false;
     }
@@ -603,7 +647,8 @@ bool Interpreter::exec(const Stmt& s, Frame& f) const
         fail(s.pos, "loop bounds must be numbers");
       const double from = std::ceil(a.number), to = std::ceil(b.number);
       if (to - from > static_cast<double>(maxIterations - f.iterations))
-        fail(s.pos, "the loop would run more than " + std::to_string(maxIterations) +
+        fail(s.pos,
+          "the loop would run more than " + std::to_string(maxIterations) +
             " iterations in one reaction");
       for (double i = from; i < to; ++i)
       {
@@ -668,8 +713,7 @@ void Interpreter::assign(const Expr& target, const std::string& op, Value v, Fra
   if (comp >= 0)
   {
     if (!v.isNumber() && op == "=")
-      fail(target.pos, std::string("a vector component takes a number, not a ") +
-          typeName(v.type));
+      fail(target.pos, std::string("a vector component takes a number, not a ") + typeName(v.type));
     Value c = Value::real(current.vec[comp]);
     if (op != "=")
     {
@@ -707,8 +751,9 @@ void Interpreter::assign(const Expr& target, const std::string& op, Value v, Fra
     else
     {
       if (!current.isNumber() || !v.isNumber())
-        fail(target.pos, std::string("'") + op + "' needs numbers, not a " +
-            typeName(current.type) + " and a " + typeName(v.type));
+        fail(target.pos,
+          std::string("'") + op + "' needs numbers, not a " + typeName(current.type) + " and a " +
+            typeName(v.type));
       const double x = op == "+=" ? current.number + v.number
         : op == "-="              ? current.number - v.number
         : op == "*="              ? current.number * v.number
@@ -724,8 +769,8 @@ void Interpreter::assign(const Expr& target, const std::string& op, Value v, Fra
     Value& slot = f.locals[root];
     if (slot.type != Value::Type::None && slot.type != next.type &&
       !(slot.isNumber() && next.isNumber()))
-      fail(target.pos, "'" + root + "' is a " + typeName(slot.type) + ", not a " +
-          typeName(next.type));
+      fail(target.pos,
+        "'" + root + "' is a " + typeName(slot.type) + ", not a " + typeName(next.type));
     if (slot.type == Value::Type::Int && next.isNumber())
       next = Value::integer(next.number);
     else if (slot.type == Value::Type::Real && next.isNumber())
@@ -734,12 +779,14 @@ void Interpreter::assign(const Expr& target, const std::string& op, Value v, Fra
     return;
   }
   if (local)
-    fail(target.pos, "'" + root + "' is a local " + typeName(f.locals[root].type) +
-        "; it has no member '" + member + "' to assign");
+    fail(target.pos,
+      "'" + root + "' is a local " + typeName(f.locals[root].type) + "; it has no member '" +
+        member + "' to assign");
   try
   {
     if (!f.scope.assign(root, member, next))
-      fail(target.pos, "cannot assign to '" + (member.empty() ? root : root + "." + member) +
+      fail(target.pos,
+        "cannot assign to '" + (member.empty() ? root : root + "." + member) +
           "': not a parameter or property that code can set");
   }
   catch (const ModelError&)

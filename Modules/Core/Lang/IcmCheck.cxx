@@ -177,8 +177,8 @@ public:
       declare(animations_, a.name, &a, "animation");
       animation(a);
     }
-    if (!m_.cycles.text.empty() && m_.cycles.text != "previous" &&
-      m_.cycles.text != "reevaluate" && m_.cycles.text != "cut")
+    if (!m_.cycles.text.empty() && m_.cycles.text != "previous" && m_.cycles.text != "reevaluate" &&
+      m_.cycles.text != "cut")
     {
       err(m_.cycles.pos,
         "unknown cycle policy '" + m_.cycles.text + "' (previous, reevaluate or cut)");
@@ -401,7 +401,8 @@ private:
         if (p.values.size() != 1 || p.values[0]->kind != Expr::Kind::Name ||
           kinds.count(p.values[0]->text) == 0)
         {
-          err(p.pos, "unknown " + p.name + " (" +
+          err(p.pos,
+            "unknown " + p.name + " (" +
               (p.name == "interpolation" ? "step, linear, catmullrom or hermite"
                                          : "constant, linear, loop or mirror") +
               ")");
@@ -409,8 +410,8 @@ private:
       }
       else
       {
-        err(p.pos, "unknown animation property '" + p.name +
-            "' (keys, interpolation, before, after)");
+        err(p.pos,
+          "unknown animation property '" + p.name + "' (keys, interpolation, before, after)");
       }
     }
     if (!hasKeys)
@@ -2313,8 +2314,9 @@ private:
       {
         if (n != 2)
         {
-          err(e.pos, "fireEvent(TIME_REJECTED, step) takes the step to retry with, from the "
-                     "last accepted time");
+          err(e.pos,
+            "fireEvent(TIME_REJECTED, step) takes the step to retry with, from the "
+            "last accepted time");
         }
       }
       else
