@@ -272,6 +272,7 @@ struct DynamicModel::Impl
   void setActive(std::size_t i, double t);
   FrameRecord record(double t, bool transition);
   void step(double dt);
+  void settle();
 };
 
 // ---- scopes ---------------------------------------------------------------------------------
@@ -654,6 +655,14 @@ void DynamicModel::Impl::buildCell(const CellDef& def)
     else
       c.params.push_back(spec);
   }
+  // Properties come in any order: the domain bounds the fields however late it is given.
+  for (ShapePart& part : c.parts)
+    if (part.kind == ShapePart::Kind::Field)
+    {
+      if (!c.hasDomain)
+        fail(def.pos, "the cell " + c.name + " has a field shape but no domain (its bounds)");
+      part.bounds = c.domain;
+    }
   for (const Procedure& r : def.reactions)
     c.reactions[reactionKey(r)] = &r;
   if (c.operands && !c.parts.empty())
@@ -1510,6 +1519,18 @@ void DynamicModel::Impl::step(double dt)
   }
 }
 
+void DynamicModel::Impl::settle()
+{
+  try
+  {
+    stepper->settle();
+  }
+  catch (const dyn::ModelError& e)
+  {
+    fail(instances[s.active].pos, e.what());
+  }
+}
+
 // ---- EngineScope ----------------------------------------------------------------------------
 
 namespace
@@ -1877,14 +1898,7 @@ FrameRecord DynamicModel::start()
     m.stepper->restore(initial);
     m.s.active = kNone;
     m.setActive(chosen, t);
-    try
-    {
-      m.stepper->settle();
-    }
-    catch (const dyn::ModelError& e)
-    {
-      m.fail(m.instances[chosen].pos, e.what());
-    }
+    m.settle();
     const std::size_t now = unique(m.validInstances(t));
     if (now == chosen)
       break;
@@ -1943,10 +1957,42 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
           hi = mid;
       }
       valid = probe(hi);
-      // A transition at `hi`: the frame that reaches it is evaluated by the new instance (its
-      // init, update and updatePost), so the state recorded at hi is the new instance's. The
-      // new instance may itself be valid only at that instant (a tangency, a collision): then
-      // the next one follows at the same time, without re-running the frame.
+      if (valid.size() != 1)
+      {
+        // Predicates are numerical: where two of them flip within the geometric tolerance of
+        // each other (a query that says "touching" a little before another counts the point)
+        // no instance, or two, may be valid for a moment. Look a little later for the first
+        // time with exactly one, up to 1e3 x the time tolerance.
+        const double reach = std::min(target, hi + 1e3 * m.options.timeTolerance);
+        double a = hi, b = hi;
+        bool found = false;
+        for (double d = m.options.timeTolerance; !found && b < reach; d *= 2.0)
+        {
+          b = std::min(hi + d, reach);
+          found = probe(b).size() == 1;
+          if (!found)
+            a = b;
+        }
+        if (found)
+        {
+          while (b - a > m.options.timeTolerance * 1e-3 && a + 0.5 * (b - a) > a)
+          {
+            const double mid = a + 0.5 * (b - a);
+            if (probe(mid).size() == 1)
+              b = mid;
+            else
+              a = mid;
+          }
+          hi = b;
+        }
+        valid = probe(hi);
+      }
+      // A transition at `hi`: the state is the one the old instance's frame reached (what its
+      // reactions decided, e.g. a latch, is kept); the new instance then settles at that time
+      // (its init, its relations, its updates with dt = 0, its updatePost), so the state
+      // recorded at hi is the new instance's. If that makes yet another instance the valid one
+      // (an instance valid only at an instant: the tangency of thesis 5.1, Newton's cradle's
+      // contact), it follows at the same time.
       for (int hop = 0;; ++hop)
       {
         if (valid.size() != 1)
@@ -1954,7 +2000,7 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
           std::string names;
           for (std::size_t i : valid)
             names += (names.empty() ? "" : ", ") + m.instances[i].name;
-          m.fail({ 1, 1 },
+          m.fail(m.instances[m.s.active].pos,
             "at t = " + std::to_string(hi) + " after " + m.instances[m.s.active].name + ", " +
               (valid.empty() ? std::string("no instance is valid")
                              : "several instances are valid: " + names) +
@@ -1963,21 +2009,10 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
         if (valid[0] == m.s.active)
           break;
         if (hop > 16)
-          m.fail({ 1, 1 },
+          m.fail(m.instances[m.s.active].pos,
             "at t = " + std::to_string(hi) + " the instances keep switching without time passing");
-        const std::size_t next = valid[0];
-        if (hop == 0)
-        {
-          // The old instance runs to `lo`, the last time it was the only valid one; the frame
-          // from there to `hi` is the new instance's.
-          m.stepper->restore(snap);
-          if (lo > now)
-            m.step(lo - now);
-          m.setActive(next, hi);
-          m.step(hi - lo);
-        }
-        else
-          m.setActive(next, hi);
+        m.setActive(valid[0], hi);
+        m.settle();
         out.push_back(m.record(hi, true));
         valid = m.validInstances(hi);
       }
