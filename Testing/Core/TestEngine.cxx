@@ -362,3 +362,49 @@ TEST(EngineInterpreter, TypeErrorsAtRunTime)
     EXPECT_NE(std::string(e.what()).find("flag is a bool"), std::string::npos) << e.what();
   }
 }
+
+// The complex of the active instance: its cells with their dimensions and the instance's
+// boundary and containment relations (thesis 5.1 K3; 5.6 EGG_GOING_DOWN).
+TEST(EngineComplex, RelationsOfTheActiveInstance)
+{
+  DynamicModel m = load("ch5_1_disk_rectangle.icm");
+  m.advanceTo(4.0, 0.5);
+  const ictk::complex::Complex c = m.complex();
+  const auto cells = m.cells();
+  // DEQS, LHKF, then K3's T-cells: half-disk (2D), arc, chord (1D), K, L (0D).
+  ASSERT_EQ(cells.size(), 7u);
+  EXPECT_EQ(c.cellsOfDimension(2).size(), 3u);
+  EXPECT_EQ(c.cellsOfDimension(1).size(), 2u);
+  EXPECT_EQ(c.cellsOfDimension(0).size(), 2u);
+  // K3 declares six boundary pairs: the chord and the arc bound the half-disk, K and L bound both.
+  EXPECT_EQ(c.boundaryPairCount(), 6u);
+  auto id = [&](const std::string& n)
+  {
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      if (cells[i].name == n)
+        return static_cast<ictk::complex::CellId>(i);
+    ADD_FAILURE() << n;
+    return ictk::complex::CellId(0);
+  };
+  EXPECT_TRUE(c.hasBoundary(id("KFL_half_disk"), id("KL_segment")));
+  EXPECT_TRUE(c.hasBoundary(id("KL_segment"), id("K_point")));
+
+  DynamicModel egg = load("andyhausen.icm");
+  egg.advanceTo(1.0, 0.5);
+  const ictk::complex::Complex e = egg.complex();
+  const auto ecells = egg.cells();
+  auto eid = [&](const std::string& n)
+  {
+    for (std::size_t i = 0; i < ecells.size(); ++i)
+      if (ecells[i].name == n)
+        return static_cast<ictk::complex::CellId>(i);
+    ADD_FAILURE() << n;
+    return ictk::complex::CellId(0);
+  };
+  EXPECT_TRUE(e.hasContainment(eid("Eggshell"), eid("Egg_contents")));
+  EXPECT_TRUE(e.hasBoundary(eid("Eggshell"), eid("Hook")));
+  // Cells of every dimension coexist: the hook 0D, the rope 1D, the egg 3D.
+  EXPECT_EQ(e.cell(eid("Hook")).dimension, 0);
+  EXPECT_EQ(e.cell(eid("Rope")).dimension, 1);
+  EXPECT_EQ(e.cell(eid("Eggshell")).dimension, 3);
+}

@@ -720,9 +720,17 @@ void DynamicModel::Impl::buildShape(CellSpec& c, const Property& p)
     }
     auto num = [&](std::size_t i)
     {
-      if (i >= args.size() || !args[i].isNumber())
-        fail(v->pos, f + ": argument " + std::to_string(i + 1) + " must be a number");
+      if (i >= args.size() || !args[i].isNumber() || !std::isfinite(args[i].number))
+        fail(v->pos, f + ": argument " + std::to_string(i + 1) + " must be a finite number");
       return args[i].number;
+    };
+    // Sizes, radii and blend amounts.
+    auto size = [&](std::size_t i)
+    {
+      const double x = num(i);
+      if (x < 0.0)
+        fail(v->pos, f + ": argument " + std::to_string(i + 1) + " must not be negative");
+      return x;
     };
     auto point = [&](std::size_t i)
     {
@@ -775,22 +783,22 @@ void DynamicModel::Impl::buildShape(CellSpec& c, const Property& p)
     {
       part.kind = f == "arc" ? ShapePart::Kind::Arc : ShapePart::Kind::CircularSegment;
       part.points = { point(0), point(1) };
-      part.radius = num(2);
+      part.radius = size(2);
     }
     else if (f == "rectangle")
     {
       part.kind = ShapePart::Kind::Rectangle;
-      part.size = { num(0), num(1), 0.0 };
+      part.size = { size(0), size(1), 0.0 };
     }
     else if (f == "disk" || f == "sphere")
     {
       part.kind = f == "disk" ? ShapePart::Kind::Disk : ShapePart::Kind::Sphere;
-      part.radius = num(0);
+      part.radius = size(0);
     }
     else if (f == "box")
     {
       part.kind = ShapePart::Kind::Box;
-      part.size = { num(0), num(1), num(2) };
+      part.size = { size(0), size(1), size(2) };
     }
     else if (f == "blend" || f == "union")
     {
@@ -798,7 +806,7 @@ void DynamicModel::Impl::buildShape(CellSpec& c, const Property& p)
         fail(v->pos, f + " takes two cells");
       c.operands =
         CellSpec::Operands{ f == "blend" ? ShapePart::Kind::Blend : ShapePart::Kind::Union,
-          args[0].text, args[1].text, f == "blend" ? num(2) : 0.0 };
+          args[0].text, args[1].text, f == "blend" ? size(2) : 0.0 };
       continue;
     }
     else
@@ -2053,7 +2061,15 @@ complex::Complex DynamicModel::complex() const
   std::map<std::string, complex::CellId> ids;
   for (const CellState& c : cells())
   {
-    complex::Cell cell = toComplexCell(*c.shape, c.kind, m.options.geometry);
+    complex::Cell cell;
+    try
+    {
+      cell = toComplexCell(*c.shape, c.kind, m.options.geometry);
+    }
+    catch (const std::exception& e)
+    {
+      m.fail(m.cells[m.cellIndex.at(c.name)].pos, "the cell " + c.name + ": " + e.what());
+    }
     cell.name = c.name;
     cell.priority = m.cells[m.cellIndex.at(c.name)].priority;
     ids[c.name] = cx.addCell(std::move(cell));
