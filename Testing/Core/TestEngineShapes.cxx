@@ -739,3 +739,127 @@ TEST(EngineShapes, PointsPolylinesAndMoreCells)
   }
   EXPECT_NEAR(hits[0][0], -hits[1][0], 1e-12);
 }
+
+// Data/Models/icm/ch5_2_dependency.icm at t = 3: the HyperFun disk 0.25 - x^2 - y^2 (domain
+// [-0.5, 0.5]^2) at (1, c) above the rectangle [-2, 2] x [-1, 1], swept through the tangency
+// with its top edge (c = 1.5) in steps of 1e-9. Touching must mean the same to every query:
+// intersects == (distance <= tolerance), and intersects iff there are meeting points or one
+// shape holds the other; otherwise a model whose instances are `!intersects` and
+// `intersectionCount == 1` has no valid instance at some time.
+TEST(EngineShapes, TouchingIsOneCriterion)
+{
+  const Shape deqs = rectangle(4, 2, {}, "DEQS");
+  int touching = 0;
+  double worst = 0;
+  for (int k = 0; k <= 2000; ++k)
+  {
+    const double c = 1.5 - 1e-6 + k * 1e-9;
+    Shape lhkf = fieldDisk(0.5, at(1, c), "LHKF");
+    lhkf.parts[0].bounds = { { -0.5, -0.5, 0 }, { 0.5, 0.5, 0 } };
+    const auto joint = deqs.worldBounds();
+    const auto box = lhkf.worldBounds();
+    const double dx = std::max(joint.hi[0], box.hi[0]) - std::min(joint.lo[0], box.lo[0]);
+    const double dy = std::max(joint.hi[1], box.hi[1]) - std::min(joint.lo[1], box.lo[1]);
+    const double dz = std::max(joint.hi[2], box.hi[2]) - std::min(joint.lo[2], box.lo[2]);
+    const double tol = 1e-9 * std::sqrt(dx * dx + dy * dy + dz * dz);
+    const double d = engine::distance(deqs, lhkf);
+    const bool meets = engine::intersects(deqs, lhkf);
+    const auto points = engine::intersectionPoints(deqs, lhkf);
+    const bool inside = engine::contains(deqs, lhkf) || engine::contains(lhkf, deqs);
+    ASSERT_EQ(meets, d <= tol) << "c = " << c << ", distance " << d;
+    ASSERT_EQ(meets, !points.empty() || inside) << "c = " << c << ", distance " << d;
+    // The gap is c - 0.5 - 1 above the edge.
+    const double gap = c - 1.5;
+    worst = std::max(worst, std::abs(d - std::max(gap, 0.0)));
+    if (gap > 0)
+    {
+      EXPECT_EQ(points.size(), gap <= tol ? 1u : 0u) << "c = " << c;
+    }
+    touching += std::abs(gap) <= tol && points.size() == 1;
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(touching, 0); // the steps of 1e-9 meet the tangency window (2 x ~4.7e-9 wide)
+  // The same for an ellipse turned by 0.5 rad, whose centre is not above its lowest point:
+  // the projections from the centres do not start at the nearest pair. Its lowest point is
+  // sqrt(0.5^2 sin^2 + 0.25^2 cos^2) below the centre.
+  using frep::Expr;
+  ShapePart ellipse;
+  ellipse.kind = ShapePart::Kind::Field;
+  ellipse.fieldDimension = 2;
+  ellipse.field = fieldOf(1 - square(Expr::x() / 0.5) - square(Expr::y() / 0.25));
+  ellipse.bounds = { { -0.5, -0.25, 0 }, { 0.5, 0.25, 0 } };
+  const double drop =
+    std::hypot(0.5 * std::sin(0.5), 0.25 * std::cos(0.5)); // the lowest point below the centre
+  for (int k = -20; k <= 20; ++k)
+  {
+    const double gap = k * 1e-9;
+    const Shape e = shapeOf(
+      "E", 2, ellipse, Affine::fromTransform({ 1, 1 + drop + gap, 0 }, { 0, 0, 0.5 }, { 1, 1, 1 }));
+    const auto joint = deqs.worldBounds();
+    const auto box = e.worldBounds();
+    const double dx = std::max(joint.hi[0], box.hi[0]) - std::min(joint.lo[0], box.lo[0]);
+    const double dy = std::max(joint.hi[1], box.hi[1]) - std::min(joint.lo[1], box.lo[1]);
+    const double tol = 1e-9 * std::hypot(dx, dy);
+    const double d = engine::distance(deqs, e);
+    const bool meets = engine::intersects(deqs, e);
+    const auto points = engine::intersectionPoints(deqs, e);
+    EXPECT_NEAR(d, std::max(gap, 0.0), 1e-12) << "gap " << gap;
+    ASSERT_EQ(meets, d <= tol) << "gap " << gap << ", distance " << d;
+    ASSERT_EQ(meets, !points.empty()) << "gap " << gap << ", distance " << d;
+  }
+}
+
+// The egg of Data/Models/icm/andyhausen.icm, eroded by a (1 - ... - 0.2 a), sinking into the
+// liquid: the liquid holds it exactly when its top c + 0.7 sqrt(1 - 0.2 a) is at or below the
+// surface -3.2. The flip is found by bisection on the centre height c.
+TEST(EngineShapes, ContainsFlipsAtTheExactPlacement)
+{
+  using frep::Expr;
+  const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
+  ShapePart liquid;
+  liquid.kind = ShapePart::Kind::Field;
+  liquid.field = fieldOf(min(-3.2 - y, 4 - x * x - z * z));
+  liquid.bounds = { { -2, -5, -2 }, { 2, -3.2, 2 } };
+  const Shape pool = shapeOf("Liquid", 3, liquid);
+  for (double a : { 0.0, 0.8 })
+  {
+    SCOPED_TRACE(a);
+    ShapePart shell;
+    shell.kind = ShapePart::Kind::Field;
+    shell.field = fieldOf(1 - square(x / 0.5) - square(y / 0.7) - square(z / 0.5) - 0.2 * a);
+    shell.bounds = { { -0.5, -0.7, -0.5 }, { 0.5, 0.7, 0.5 } };
+    auto egg = [&](double c)
+    {
+      return shapeOf("Eggshell", 3, shell, at(0, c, 0));
+    };
+    const double exact = -3.2 - 0.7 * std::sqrt(1 - 0.2 * a);
+    double lo = exact - 0.05, hi = exact + 0.05; // contained at lo, not at hi
+    ASSERT_TRUE(engine::contains(pool, egg(lo)));
+    ASSERT_FALSE(engine::contains(pool, egg(hi)));
+    while (hi - lo > 1e-13)
+    {
+      const double mid = 0.5 * (lo + hi);
+      (engine::contains(pool, egg(mid)) ? lo : hi) = mid;
+    }
+    // "Up to the tolerance" means min fA over B >= -tol: the top may rise tol above the surface
+    // (the tolerance is 1e-9 x the joint diagonal, the liquid's box and the egg's).
+    const auto joint = pool.worldBounds(), own = egg(lo).worldBounds();
+    double diagonal = 0;
+    for (int i = 0; i < 3; ++i)
+    {
+      const double w = std::max(joint.hi[i], own.hi[i]) - std::min(joint.lo[i], own.lo[i]);
+      diagonal += w * w;
+    }
+    const double tol = 1e-9 * std::sqrt(diagonal);
+    std::printf(
+      "a = %.1f: contains flips at %.15f, exact %.15f: error %.3e = tolerance %.3e %+.1e\n", a, lo,
+      exact, lo - exact, tol, lo - exact - tol);
+    EXPECT_NEAR(lo - exact, tol, 1e-12);
+    EXPECT_NEAR(lo, exact, 1e-6);
+    const double us = microseconds(20, [&] { engine::contains(pool, egg(exact - 1e-7)); });
+    const double usOut = microseconds(20, [&] { engine::contains(pool, egg(exact + 1e-7)); });
+    std::printf("contains near the flip: %.1f us (inside), %.1f us (outside)\n", us, usOut);
+    EXPECT_LT(us, 1000);
+    EXPECT_LT(usOut, 1000);
+  }
+}

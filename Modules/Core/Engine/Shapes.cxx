@@ -19,9 +19,26 @@
 //   alternating projections, exact for convex shapes (a local minimum otherwise). Projections
 //   onto fields are Newton steps onto {f = 0} alternating with moves to the foot on the
 //   tangent plane, from the nearest inside grid sample when the gradient does not lead there.
-// - intersects / contains between solids with fields: branch and bound on the interval
-//   enclosures (tape fields' own interval evaluators, interval arithmetic through the
-//   placement and the analytic parts), with a witness point deciding each box's centre.
+//   Near a tangency alternating projections crawl (each round trip gains ~gap / radius), so
+//   after a few rounds they climb B's field along A to the least gap and go on from there:
+//   within 1e-12 in the tests (sizes ~1). Between solids with fields, a branch and bound also looks
+//   for a point inside both (distance 0) and refines from the boxes where the two nearly
+//   touch.
+// - Touching: intersects() is that same distance <= tolerance, and a tangency point of
+//   intersectionPoints() is a first-order distance <= tolerance, which agree up to rounding and
+//   second-order terms (~gap^2 / radius): a pair intersects exactly when it has meeting points
+//   or one holds the other, as long as the distance finds the nearest pair, except for gaps
+//   within ~1e-16 x the size of the tolerance itself, where rounding decides each on its own.
+// - contains between solids with fields: "no point with fB >= 0 and fA < -tolerance", proved
+//   by branch and bound on the interval enclosures (tape fields' own interval evaluators,
+//   interval arithmetic through the placement and the analytic parts) or refuted by a witness
+//   point. Where B's boundary runs along A's from inside, enclosures cannot decide, so the
+//   boxes stop at 1e-2 (2D) / 1e-1 (3D) of B's box and the lowest fA over B is found by a
+//   projected descent from the best leaves: the answer flips where min fA over B = -tolerance
+//   (A's field values, not a distance), to ~1e-13 (measured on the egg in the liquid), when
+//   A's lowest point on B is in the basin of one of those descents; a local search, so likely
+//   rather than proved when fA has several minima on B.
+//   Tens of microseconds for small HyperFun fields (TestEngineShapes prints the figures).
 // - Areas: exact for convex analytic regions (polygon clipping, disk against a polygon by
 //   triangle fans, lenses of disks), volumes of spheres, lenses, axis-aligned boxes; otherwise
 //   interval-pruned subdivision with a plane estimate per boundary cell and Richardson
@@ -1727,38 +1744,173 @@ Vec3 closestPoint(const Prepared& s, Vec3 x)
   return best;
 }
 
-/// Alternating projections between the shapes from both centres: the nearest pair for convex
-/// shapes, a local one otherwise.
-double alternatingDistance(const Prepared& a, const Prepared& b)
+/// Newton steps towards {f >= 0} along grad f, each at most `maxStep` long (none from inside).
+Vec3 intoShape(const Prepared& s, Vec3 x, double maxStep)
 {
-  double best = Inf;
-  const Vec3 seeds[2] = { b.bounds.centre(), a.bounds.centre() };
-  for (int k = 0; k < 2; ++k)
+  const int axes = s.flat ? 2 : 3;
+  for (int k = 0; k < 8; ++k)
   {
-    const Prepared& first = k == 0 ? a : b;
-    const Prepared& second = k == 0 ? b : a;
-    Vec3 p = closestPoint(first, seeds[k]);
-    Vec3 q = closestPoint(second, p);
-    double d = dist3(p, q);
-    for (int it = 0; it < 500 && d > 0; ++it)
+    Vec3 g;
+    const double f = s.gradient(x, g);
+    const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    if (f >= 0 || !std::isfinite(f) || !(g2 > 0))
     {
-      const Vec3 p2 = closestPoint(first, q);
-      const Vec3 q2 = closestPoint(second, p2);
-      const double d2 = dist3(p2, q2);
-      p = p2;
-      q = q2;
-      // The distance is stationary at the nearest pair, so its error is about the last
-      // decrease over (1 - the contraction rate).
-      const bool stalled = d - d2 <= 1e-12 * std::max(a.scale, b.scale);
-      d = std::min(d, d2);
-      if (stalled)
+      break;
+    }
+    double step = -f / g2;
+    const double len = step * std::sqrt(g2);
+    if (len > maxStep)
+    {
+      step *= maxStep / len;
+    }
+    for (int i = 0; i < axes; ++i)
+    {
+      x[i] += step * g[i];
+    }
+    // Quadratic convergence: the next step would be below rounding.
+    if (len <= 1e-12 * s.scale)
+    {
+      break;
+    }
+  }
+  return x;
+}
+
+/// A local minimum of sign x fA over {fB >= 0} from x (left where it ends): steps along the
+/// descent direction, tangent to B's boundary where they would leave B, pulled back onto B by
+/// Newton steps, the step length doubled after a success and halved after a failure, down to
+/// 1e-9 of the size (the value then varies by ~curvature x step^2 at most). `inB` is how far
+/// outside B (first order) a point may be and still count as B's (rounding of the Newton
+/// steps). Stops early once the objective < `stop`. Returns the objective there (+inf when x
+/// could not be brought into B).
+double lowestInside(const Prepared& a, const Prepared& b, Vec3& x, double step, double inB,
+  double stop, double sign = 1)
+{
+  const int axes = a.flat && b.flat ? 2 : 3;
+  auto objective = [&](const Vec3& y, Vec3& g)
+  {
+    const double v = sign * a.gradient(y, g);
+    for (auto& c : g)
+    {
+      c *= sign;
+    }
+    return v;
+  };
+  auto member = [&](const Vec3& y)
+  {
+    return b.value(y) >= 0 || b.boundaryDistance(y) <= inB;
+  };
+  x = intoShape(b, x, step);
+  if (!member(x))
+  {
+    return Inf;
+  }
+  Vec3 ga;
+  double fa = objective(x, ga);
+  const double smallest = 1e-9 * std::max(a.scale, b.scale);
+  for (int it = 0; it < 200 && fa >= stop && step > smallest; ++it)
+  {
+    Vec3 gb;
+    const double fb = b.gradient(x, gb);
+    Vec3 d{ -ga[0], -ga[1], axes == 3 ? -ga[2] : 0.0 };
+    const double gb2 = gb[0] * gb[0] + gb[1] * gb[1] + gb[2] * gb[2];
+    const double out = d[0] * gb[0] + d[1] * gb[1] + d[2] * gb[2];
+    // Only on the boundary itself: inside, B's active piece need not be its boundary there (a
+    // clipping domain's face above a field's top), and a step out is pulled back anyway.
+    if (gb2 > 0 && out < 0 && fb <= inB * std::sqrt(gb2))
+    {
+      for (int i = 0; i < axes; ++i)
       {
-        break;
+        d[i] -= out / gb2 * gb[i];
       }
     }
-    best = std::min(best, d);
+    const double dn = norm3(d);
+    if (!(dn > 0))
+    {
+      break;
+    }
+    bool moved = false;
+    while (!moved && step > smallest)
+    {
+      Vec3 y = x;
+      for (int i = 0; i < axes; ++i)
+      {
+        y[i] += step * d[i] / dn;
+      }
+      y = intoShape(b, y, step);
+      Vec3 gy;
+      const double fy = member(y) ? objective(y, gy) : Inf;
+      if (fy < fa)
+      {
+        x = y;
+        fa = fy;
+        ga = gy;
+        step *= 2;
+        moved = true;
+      }
+      else
+      {
+        step *= 0.5;
+      }
+    }
   }
-  return best;
+  return fa;
+}
+
+/// Alternating projections between the shapes from a seed projected onto `first`: the nearest
+/// pair for convex shapes, a local one otherwise.
+double alternatingFrom(const Prepared& first, const Prepared& second, const Vec3& seed)
+{
+  const double scale = std::max(first.scale, second.scale);
+  Vec3 p = closestPoint(first, seed);
+  Vec3 q = closestPoint(second, p);
+  double d = dist3(p, q);
+  for (int it = 0; it < 500 && d > 0; ++it)
+  {
+    if (it == 16 && first.solid() && second.solid())
+    {
+      // Still going: nearly tangent boundaries, where a round trip gains only ~gap / radius of
+      // the offset from the nearest pair, which then costs ~offset^2 / radius of distance.
+      // Climb fB along A instead (its maximum over A is where the gap is least, to first order
+      // in the gap), and go on alternating from there.
+      Vec3 x = p;
+      const double top =
+        -lowestInside(second, first, x, std::max(d, 1e-3 * scale), 1e-12 * scale, 0.0, -1.0);
+      if (top < Inf)
+      {
+        const Vec3 p2 = closestPoint(first, x);
+        const Vec3 q2 = closestPoint(second, p2);
+        if (dist3(p2, q2) < d)
+        {
+          p = p2;
+          q = q2;
+          d = dist3(p2, q2);
+          continue;
+        }
+      }
+    }
+    const Vec3 p2 = closestPoint(first, q);
+    const Vec3 q2 = closestPoint(second, p2);
+    const double d2 = dist3(p2, q2);
+    p = p2;
+    q = q2;
+    // The distance is stationary at the nearest pair, so its error is about the last
+    // decrease over (1 - the contraction rate).
+    const bool stalled = d - d2 <= 1e-12 * scale;
+    d = std::min(d, d2);
+    if (stalled)
+    {
+      break;
+    }
+  }
+  return d;
+}
+
+/// From both centres (the second only when the first gives more than `enough`).
+double alternatingDistance(const Prepared& a, const Prepared& b, double enough = 0)
+{
+  const double d = alternatingFrom(a, b, b.bounds.centre());
+  return d > enough ? std::min(d, alternatingFrom(b, a, a.bounds.centre())) : d;
 }
 
 /// A point of each piece (to test whether one shape has points inside the other).
@@ -1832,21 +1984,6 @@ bool sphereSphere(const Prepared& s, Vec3& centre, double& radius)
   return true;
 }
 
-double distanceOf(const Prepared& a, const Prepared& b)
-{
-  if (a.analytic && b.analytic)
-  {
-    return analyticDistance(a, b);
-  }
-  Vec3 ca, cb;
-  double ra, rb;
-  if (sphereSphere(a, ca, ra) && sphereSphere(b, cb, rb))
-  {
-    return std::max(0.0, dist3(ca, cb) - ra - rb);
-  }
-  return alternatingDistance(a, b);
-}
-
 // ---------------------------------------------------------------------------------------------
 // Branch and bound over boxes with the shapes' interval enclosures.
 
@@ -1854,10 +1991,12 @@ double distanceOf(const Prepared& a, const Prepared& b)
 /// arithmetic, how well a box can do; a negative promise proves there is no witness in the box.
 /// The most promising box is split first, so that an existing witness is met early. Boxes
 /// smaller than `minSize` are decided by their centre only, and at most `budget` boxes are
-/// visited; both limits are where a "no" stops being a proof.
+/// visited; both limits are where a "no" stops being a proof. `leaves`, when given, receives
+/// the boxes left undecided at `minSize` (up to 4096), for the caller to refine locally.
 bool searchBoxes(const Box3& box, bool flat, double minSize,
   const std::function<double(const Box3&)>& promise,
-  const std::function<bool(const Vec3&)>& witness, int budget = 200000)
+  const std::function<bool(const Vec3&)>& witness, int budget = 200000,
+  std::vector<Box3>* leaves = nullptr)
 {
   struct Item
   {
@@ -1895,6 +2034,10 @@ bool searchBoxes(const Box3& box, bool flat, double minSize,
     }
     if (b.hi[axis] - b.lo[axis] <= minSize)
     {
+      if (leaves && leaves->size() < 4096)
+      {
+        leaves->push_back(b);
+      }
       continue;
     }
     const double mid = 0.5 * (b.lo[axis] + b.hi[axis]);
@@ -1924,6 +2067,65 @@ Box3 padded(Box3 b, double pad)
     b.hi[i] += pad;
   }
   return b;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Local refinement of what the boxes leave undecided. Interval enclosures cannot separate two
+// boundaries that touch or nearly touch (the enclosures overlap at every box size), so the
+// searches stop at a box size and the leaves they leave are decided by local optimisation from
+// their centres: accurate to rounding at the optimum it converges to, but a local optimum, so
+// only as good as the leaves' centres are as starting points (the few best are refined).
+
+/// The distance between two shapes, one number for distance() and intersects() (which compares
+/// it with the tolerance), so that the two never disagree: exact for analytic pairs and
+/// similar spheres; otherwise alternating projections from the centres, 0 when the boxes find
+/// a point inside both, and the alternating projections again from the most promising leaves
+/// (where the boundaries nearly touch). Returns as soon as it is known to be <= `enough`.
+double separation(const Prepared& a, const Prepared& b, double enough)
+{
+  if (a.analytic && b.analytic)
+  {
+    return analyticDistance(a, b);
+  }
+  Vec3 ca, cb;
+  double ra, rb;
+  if (sphereSphere(a, ca, ra) && sphereSphere(b, cb, rb))
+  {
+    return std::max(0.0, dist3(ca, cb) - ra - rb);
+  }
+  double d = alternatingDistance(a, b, enough);
+  if (d <= enough || !a.solid() || !b.solid())
+  {
+    return d;
+  }
+  const bool flat = a.flat && b.flat;
+  const Box3 box = flatten(meetBoxes(a.bounds, b.bounds), flat);
+  if (!box.valid())
+  {
+    return d;
+  }
+  std::vector<Box3> leaves;
+  const double minSize = (flat ? 1e-3 : 2e-2) * boxDiagonal(box);
+  if (searchBoxes(
+        box, flat, minSize, [&](const Box3& c) { return std::min(a.bound(c).hi, b.bound(c).hi); },
+        [&](const Vec3& p) { return std::min(a.value(p), b.value(p)) >= 0; }, 200000, &leaves))
+  {
+    return 0;
+  }
+  std::vector<std::pair<double, Vec3>> seeds;
+  for (const auto& leaf : leaves)
+  {
+    const Vec3 c = leaf.centre();
+    seeds.push_back({ -std::min(a.value(c), b.value(c)), c });
+  }
+  const std::size_t refined = std::min<std::size_t>(seeds.size(), 4);
+  std::partial_sort(seeds.begin(), seeds.begin() + refined, seeds.end(),
+    [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (std::size_t i = 0; i < refined && d > enough; ++i)
+  {
+    d = std::min(d, alternatingFrom(a, b, seeds[i].second));
+  }
+  return d;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -2528,36 +2730,19 @@ double distance(const Shape& a, const Shape& b, const QueryOptions& o)
 {
   checkOptions(a, b, o);
   const Prepared pa(a), pb(b);
-  return distanceOf(pa, pb);
+  return separation(pa, pb, 0.0);
 }
 
 bool intersects(const Shape& a, const Shape& b, const QueryOptions& o)
 {
   checkOptions(a, b, o);
   const Prepared pa(a), pb(b);
+  // The very number distance() returns, compared with the tolerance: touching is "distance <=
+  // tolerance" everywhere, which intersectionPoints' tangency rule (a first-order distance <=
+  // tolerance) agrees with up to rounding and second-order terms (~1e-16 for the engine's
+  // sizes), so that a pair never intersects without meeting points or one inside the other.
   const double tol = defaultTolerance(pa, pb, o);
-  if (pa.solid() && pb.solid() && !(pa.analytic && pb.analytic))
-  {
-    // A near pair of points (from the distance's projections) proves a touching that a box
-    // centre would have to hit within the tolerance; the boxes prove the rest.
-    if (alternatingDistance(pa, pb) <= tol)
-    {
-      return true;
-    }
-    // max over x of min(fA, fB) >= -tol, proved by a witness point or refuted by intervals.
-    const bool flat = pa.flat && pb.flat;
-    const Box3 box = flatten(padded(meetBoxes(pa.bounds, pb.bounds), tol), flat);
-    if (!box.valid())
-    {
-      return false;
-    }
-    const double minSize = std::max(tol, 1e-7 * boxDiagonal(box));
-    return searchBoxes(
-      box, flat, minSize,
-      [&](const Box3& c) { return std::min(pa.bound(c).hi, pb.bound(c).hi) + tol; },
-      [&](const Vec3& p) { return std::min(pa.value(p), pb.value(p)) >= -tol; });
-  }
-  return distanceOf(pa, pb) <= tol;
+  return separation(pa, pb, tol) <= tol;
 }
 
 bool contains(const Shape& a, const Shape& b, const QueryOptions& o)
@@ -2614,12 +2799,18 @@ bool contains(const Shape& a, const Shape& b, const QueryOptions& o)
     }
     return true;
   }
-  // Solids: no point with fB >= 0 and fA < -tol.
+  // Solids: no point with fB >= 0 and fA < -tol. The boxes prove it where A's enclosure stays
+  // above -tol, or find a witness; where B's boundary runs along A's (B touching A from
+  // inside) no box size decides, so they stop at 1e-2 (2D) or 1e-1 (3D) of B's box, coarse
+  // to stay cheap, and the lowest fA over B is found by descent from the best few leaves: the
+  // answer then flips within the descent's accuracy (~1e-13 measured) of the placement where
+  // min fA over B = -tol, as long as A's lowest point on B is the minimum that one of those
+  // descents reaches (a local search from up to four distinct leaves, ranked by fA: right
+  // whenever the lowest point is in one of their basins, likely but not proved).
   const bool flat = pa.flat && pb.flat;
   const Box3 box = flatten(pb.bounds, flat);
-  // Where B's boundary runs along A's (B touching A from inside), boxes stay undecided down
-  // to this size, whose centres then decide: 1e-3 (2D) or 2e-2 (3D) of B's box.
-  const double minSize = std::max(tol, (flat ? 1e-3 : 2e-2) * boxDiagonal(box));
+  const double minSize = std::max(tol, (flat ? 1e-2 : 1e-1) * boxDiagonal(box));
+  std::vector<Box3> leaves;
   const bool escapes = searchBoxes(
     box, flat, minSize,
     [&](const Box3& c)
@@ -2627,8 +2818,42 @@ bool contains(const Shape& a, const Shape& b, const QueryOptions& o)
       const double outside = -tol - pa.bound(c).lo;
       return outside > 0 ? std::min(pb.bound(c).hi, outside) : -1.0;
     },
-    [&](const Vec3& p) { return pb.value(p) >= 0 && pa.value(p) < -tol; });
-  return !escapes;
+    [&](const Vec3& p) { return pb.value(p) >= 0 && pa.value(p) < -tol; }, 200000, &leaves);
+  if (escapes)
+  {
+    return false;
+  }
+  // Rank the leaves by fA where their centres land on B; a leaf near where an earlier descent
+  // ended would descend to the same point.
+  std::vector<std::pair<double, Vec3>> seeds;
+  for (const auto& leaf : leaves)
+  {
+    const Vec3 p = intoShape(pb, leaf.centre(), minSize);
+    seeds.push_back({ pa.value(p), leaf.centre() });
+  }
+  std::sort(
+    seeds.begin(), seeds.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<Vec3> ends;
+  const double reach = 2 * (flat ? std::sqrt(2.0) : std::sqrt(3.0)) * minSize;
+  for (const auto& seed : seeds)
+  {
+    if (ends.size() >= 4)
+    {
+      break;
+    }
+    if (std::any_of(
+          ends.begin(), ends.end(), [&](const Vec3& e) { return dist3(e, seed.second) <= reach; }))
+    {
+      continue;
+    }
+    Vec3 x = seed.second;
+    if (lowestInside(pa, pb, x, minSize, 1e-3 * tol, -tol) < -tol)
+    {
+      return false;
+    }
+    ends.push_back(x);
+  }
+  return true;
 }
 
 std::vector<Vec3> intersectionPoints(const Shape& a, const Shape& b, const QueryOptions& o)
