@@ -1,12 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Two-material bars for the mesh tests (issue 6): [0,1]x[0,0.2]^2 and [1,2]x[0,0.2]^2 as a
-// complex read from JSON, meshed by the Kuhn split of a box grid and labelled by centroids.
+// complex read from JSON, meshed by the Kuhn split of a box grid and labelled by centroids; the
+// area of the faces a mesh has on a plane (internal surfaces).
 
 #include "Lang/ComplexFile.h"
 #include "Mesh/Attributes.h"
 #include "Mesh/Structured.h"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
 #include <string>
 
 namespace ictk::testing
@@ -55,6 +60,47 @@ inline mesh::TetMesh barMesh(const complex::Complex& k, int nx = 20, int ny = 2)
   mesh::labelByCentroid(m, k);
   mesh::assignAttributes(m, k);
   return m;
+}
+
+/// The area of the faces with every corner within `tolerance` of the plane z = z0 that two
+/// tetrahedra share; `once` gets the area of those only one tetrahedron has.
+inline double sharedAreaOnPlane(const mesh::TetMesh& m, double z0, double tolerance, double* once)
+{
+  std::map<std::array<std::uint32_t, 3>, int> faces;
+  for (const auto& t : m.tetrahedra)
+  {
+    for (int skip = 0; skip < 4; ++skip)
+    {
+      std::array<std::uint32_t, 3> f{};
+      int n = 0;
+      bool onPlane = true;
+      for (int c = 0; c < 4; ++c)
+      {
+        if (c != skip)
+        {
+          f[std::size_t(n++)] = t[std::size_t(c)];
+          onPlane = onPlane && std::abs(m.points[t[std::size_t(c)]][2] - z0) <= tolerance;
+        }
+      }
+      if (onPlane)
+      {
+        std::sort(f.begin(), f.end());
+        ++faces[f];
+      }
+    }
+  }
+  double shared = 0;
+  *once = 0;
+  for (const auto& [f, count] : faces)
+  {
+    const frep::Point3& a = m.points[f[0]];
+    const frep::Point3& b = m.points[f[1]];
+    const frep::Point3& c = m.points[f[2]];
+    const double ux = b[0] - a[0], uy = b[1] - a[1], vx = c[0] - a[0], vy = c[1] - a[1];
+    const double area = 0.5 * std::abs(ux * vy - uy * vx);
+    (count == 2 ? shared : *once) += area;
+  }
+  return shared;
 }
 
 } // namespace ictk::testing

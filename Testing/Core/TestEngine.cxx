@@ -408,3 +408,24 @@ TEST(EngineComplex, RelationsOfTheActiveInstance)
   EXPECT_EQ(e.cell(eid("Rope")).dimension, 1);
   EXPECT_EQ(e.cell(eid("Eggshell")).dimension, 3);
 }
+
+// TIME_REJECTED from the language (thesis L2075): a reaction that accepts steps of at most 0.1
+// makes the engine retry a 0.5 step with 0.1 from the last accepted time, so the count of
+// accepted frames reaching t = 1 is 10 (plus the settling frame at t = 0, which has dt = 0).
+TEST(EngineEvents, TimeRejectedFromAReaction)
+{
+  const std::string text = "STATE_PARAMETERS { frames : INT(0); }\n"
+                           "CELLS { A { type = F-CELL; shape = disk(1); dim = 2D; } }\n"
+                           "K : TEMPLATE_IC { CELLS { A; } }\n"
+                           "ONE : K { REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) {\n"
+                           "  if (dt > 0.1000001) { fireEvent(TIME_REJECTED, 0.1); }\n"
+                           "  frames += 1;\n"
+                           "} } }\n";
+  DynamicModel m = fromText(text);
+  const auto rs = m.advanceTo(1.0, 0.5);
+  EXPECT_EQ(m.value("frames").number, 11.0);
+  // The records are the requested times (0, 0.5, 1), not the sub-steps.
+  ASSERT_EQ(rs.size(), 3u);
+  EXPECT_EQ(rs[1].time, 0.5);
+  EXPECT_EQ(rs[2].time, 1.0);
+}

@@ -3,10 +3,12 @@
 // determinism and the refusals.
 #include "Complex/Discretization.h"
 #include "Complex/Locator.h"
+#include "FRep/Expr.h"
 #include "FRep/Sampling.h"
 #include "Lang/ComplexFile.h"
 #include "Mesh/CGAL/MeshCgal.h"
 #include "Mesh/Quality.h"
+#include "MeshTestModels.h"
 
 #include <gtest/gtest.h>
 
@@ -312,6 +314,92 @@ TEST(MeshCgal, Flower)
   for (const auto& [material, volume] : volumes)
   {
     EXPECT_GT(volume, 0) << m.materialNames[static_cast<std::size_t>(material - 1)];
+  }
+}
+
+frep::Expr boxExpr(double h)
+{
+  using frep::Expr;
+  const Expr c = Expr::constant(h);
+  return min(min(min(c - abs(Expr::x()), c - abs(Expr::y())), c - abs(Expr::z())), c);
+}
+
+// A 2D cell inside a solid: the square {z = 0, |x|, |y| <= 0.3} in the box [-0.5, 0.5]^3 must be
+// made of faces two tetrahedra share, and every tetrahedron still belongs to the box.
+TEST(MeshCgal, InternalSurface)
+{
+  using frep::Expr;
+  for (const bool deterministic : { true, false })
+  {
+    complex::Complex k;
+    const auto box = k.addCell(
+      complex::frepCell("box", {}, { boxExpr(0.5) }, { { -0.5, -0.5, -0.5 }, { 0.5, 0.5, 0.5 } }));
+    k.addCell(complex::frepCell("patch", { Expr::z() },
+      { Expr::constant(0.3) - abs(Expr::x()), Expr::constant(0.3) - abs(Expr::y()) },
+      { { -0.3, -0.3, -0.1 }, { 0.3, 0.3, 0.1 } }));
+    mesh::TetraOptions o;
+    o.size = 0.1;
+    o.deterministic = deterministic;
+    const mesh::TetMesh m = mesh::tetrahedralizeCgal(k, o);
+    EXPECT_NO_THROW(mesh::validate(m));
+    ASSERT_EQ(m.materialNames.size(), 1u);
+    for (std::size_t t = 0; t < m.tetrahedra.size(); ++t)
+    {
+      ASSERT_EQ(m.cells[t], box);
+      ASSERT_EQ(m.materials[t], 1);
+    }
+    EXPECT_NEAR(materialVolumes(m).at(1), 1.0, 0.01);
+    double once = 0;
+    const double area = ictk::testing::sharedAreaOnPlane(m, 0, 1e-7, &once);
+    EXPECT_NEAR(area, 0.36, 0.36 * 0.03) << (deterministic ? "deterministic" : "default");
+    EXPECT_EQ(once, 0.0);
+    // The protected rim: mesh vertices on the square's edges.
+    int onRim = 0;
+    for (const Point3& p : m.points)
+    {
+      onRim +=
+        std::abs(p[2]) < 1e-7 && std::abs(std::max(std::abs(p[0]), std::abs(p[1])) - 0.3) < 1e-6;
+    }
+    EXPECT_GE(onRim, 20);
+  }
+  // Without the patch hardly any face lies on z = 0.
+  complex::Complex plain;
+  plain.addCell(
+    complex::frepCell("box", {}, { boxExpr(0.5) }, { { -0.5, -0.5, -0.5 }, { 0.5, 0.5, 0.5 } }));
+  mesh::TetraOptions o;
+  o.size = 0.1;
+  o.deterministic = true;
+  double once = 0;
+  EXPECT_LT(
+    ictk::testing::sharedAreaOnPlane(mesh::tetrahedralizeCgal(plain, o), 0, 1e-7, &once), 0.05);
+}
+
+TEST(MeshCgal, CellWithNoVolumeIsAnError)
+{
+  using frep::Expr;
+  const Expr dx = Expr::x() - Expr::constant(2.5), dy = Expr::y() - Expr::constant(2.5),
+             dz = Expr::z() - Expr::constant(2.5);
+  for (const Expr& empty :
+    { Expr::constant(0) - sqrt(dx * dx + dy * dy + dz * dz), Expr::constant(-1) })
+  {
+    complex::Complex k;
+    k.addCell(
+      complex::frepCell("body", {}, { boxExpr(0.5) }, { { -0.5, -0.5, -0.5 }, { 0.5, 0.5, 0.5 } }));
+    k.addCell(complex::frepCell("ghost", {}, { empty }, { { 2, 2, 2 }, { 3, 3, 3 } }));
+    mesh::TetraOptions o;
+    o.size = 0.2;
+    o.deterministic = true;
+    try
+    {
+      mesh::tetrahedralizeCgal(k, o);
+      FAIL() << "a cell with no volume accepted";
+    }
+    catch (const std::invalid_argument& e)
+    {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("'ghost'"), std::string::npos) << what;
+      EXPECT_NE(what.find("no volume"), std::string::npos) << what;
+    }
   }
 }
 

@@ -4,6 +4,7 @@
 #include "FRep/Expr.h"
 #include "Mesh/Quality.h"
 #include "Mesh/TetGen/MeshTetGen.h"
+#include "MeshTestModels.h"
 
 #include <gtest/gtest.h>
 
@@ -142,6 +143,57 @@ TEST(MeshTetGen, SphereInBoxAndVoid)
   EXPECT_NEAR(materialVolume(h, 1), shell, shell * 0.03);
 }
 
+// A 2D cell inside a solid: the square {z = 0, |x|, |y| <= 0.3} in the box [-0.5, 0.5]^3 must
+// be made of faces two tetrahedra share, and every tetrahedron still belongs to the box.
+TEST(MeshTetGen, InternalSurface)
+{
+  complex::Complex k;
+  const auto solid = k.addCell(block("box", { -0.5, -0.5, -0.5 }, { 0.5, 0.5, 0.5 }));
+  const Expr x = Expr::x(), y = Expr::y();
+  k.addCell(complex::frepCell("patch", { Expr::z() },
+    { Expr::constant(0.3) - abs(x), Expr::constant(0.3) - abs(y) },
+    { { -0.3, -0.3, -0.1 }, { 0.3, 0.3, 0.1 } }));
+  mesh::TetraOptions o;
+  o.size = 0.1;
+  mesh::TetGenReport report;
+  const mesh::TetMesh m = mesh::tetrahedralizeTetGen(k, o, &report);
+  EXPECT_NO_THROW(mesh::validate(m));
+  EXPECT_EQ(report.internalCells, 1u);
+  EXPECT_GT(report.internalTriangles, 36u);
+  EXPECT_NEAR(materialVolume(m, 1), 1.0, 1e-9);
+  for (std::size_t t = 0; t < m.tetrahedra.size(); ++t)
+  {
+    ASSERT_EQ(m.cells[t], solid);
+    ASSERT_EQ(m.materials[t], 1);
+  }
+  double once = 0;
+  const double area = ictk::testing::sharedAreaOnPlane(m, 0, 1e-12, &once);
+  EXPECT_NEAR(area, 0.36, 0.36 * 0.01);
+  EXPECT_EQ(once, 0.0);
+
+  // Without the patch no face lies on z = 0 (the grid is offset from it).
+  complex::Complex plain;
+  plain.addCell(block("box", { -0.5, -0.5, -0.5 }, { 0.5, 0.5, 0.5 }));
+  const mesh::TetMesh p = mesh::tetrahedralizeTetGen(plain, o);
+  EXPECT_LT(ictk::testing::sharedAreaOnPlane(p, 0, 1e-12, &once), 0.01);
+
+  // A closed 2D cell (a sphere surface) inside the box: a region no region point reaches, still
+  // labelled as the box; its surface is faces two tetrahedra share.
+  complex::Complex closed;
+  const auto box = closed.addCell(block("box", { -0.5, -0.5, -0.5 }, { 0.5, 0.5, 0.5 }));
+  const Expr r2 = x * x + y * y + Expr::z() * Expr::z();
+  closed.addCell(complex::frepCell(
+    "shell", { Expr::constant(0.09) - r2 }, {}, { { -0.3, -0.3, -0.3 }, { 0.3, 0.3, 0.3 } }));
+  const mesh::TetMesh c = mesh::tetrahedralizeTetGen(closed, o, &report);
+  EXPECT_NO_THROW(mesh::validate(c));
+  EXPECT_EQ(report.internalCells, 1u);
+  EXPECT_NEAR(materialVolume(c, 1), 1.0, 1e-9);
+  for (std::size_t t = 0; t < c.tetrahedra.size(); ++t)
+  {
+    ASSERT_EQ(c.cells[t], box);
+  }
+}
+
 TEST(MeshTetGen, Errors)
 {
   mesh::TetraOptions o;
@@ -183,6 +235,30 @@ TEST(MeshTetGen, Errors)
     EXPECT_THROW(mesh::tetrahedralizeTetGen(k, o), std::invalid_argument);
     o.size = 0;
     EXPECT_THROW(mesh::tetrahedralizeTetGen(k, o), std::invalid_argument);
+  }
+  {
+    // A 3D cell with no volume (a ball of radius 0, a field negative everywhere) is named.
+    o.size = 0.1;
+    const Expr dx = Expr::x() - Expr::constant(2.5), dy = Expr::y() - Expr::constant(2.5),
+               dz = Expr::z() - Expr::constant(2.5);
+    for (const Expr& empty :
+      { Expr::constant(0) - sqrt(dx * dx + dy * dy + dz * dz), Expr::constant(-1) })
+    {
+      complex::Complex k;
+      k.addCell(block("body", { -1, -1, -1 }, { 1, 1, 1 }));
+      k.addCell(complex::frepCell("ghost", {}, { empty }, { { 2, 2, 2 }, { 3, 3, 3 } }));
+      try
+      {
+        mesh::tetrahedralizeTetGen(k, o);
+        FAIL() << "a cell with no volume accepted";
+      }
+      catch (const std::invalid_argument& e)
+      {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("'ghost'"), std::string::npos) << what;
+        EXPECT_NE(what.find("no volume"), std::string::npos) << what;
+      }
+    }
   }
   {
     complex::Complex k;

@@ -184,8 +184,10 @@ def check_error(ictk, work, pattern, args):
         sys.exit(f"FAIL: expected one 'ictk: error:' line, got:\n{p.stderr}")
     if not re.search(pattern, lines[0]):
         sys.exit(f"FAIL: {lines[0]!r} does not match {pattern!r}")
-    if os.path.exists(os.path.join(work, "x.vti")):
-        sys.exit("FAIL: an output file was written despite the error")
+    # Every error test writes to @WORK@/x.<ext> (or the folder x): none of them may exist.
+    written = [f for f in os.listdir(work) if f == "x" or f.startswith("x.")] if os.path.isdir(work) else []
+    if written:
+        sys.exit(f"FAIL: output written despite the error: {written}")
     no_leftovers(work)
 
 

@@ -291,8 +291,10 @@ int Stepper::step(double dt)
     {
       const Snapshot s = save();
       double requested = 0.0;
-      // The last sub-step lands exactly on the target (no rounding drift).
-      const double tNew = (h >= target - t_) ? target : t_ + h;
+      // The last sub-step lands exactly on the target (no rounding drift); a remainder below
+      // 1e-9 of the step (sums of 0.1 that fall short of 1 by 1e-16) joins the step before it
+      // instead of becoming a frame of its own.
+      const double tNew = (t_ + h >= target - 1e-9 * h) ? target : t_ + h;
       if (!(tNew > t_))
         throw StepRejectedError("the step from t = " + std::to_string(t_) +
           " has become smaller than the resolution of time");

@@ -21,6 +21,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -28,7 +29,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace ictk::mesh
@@ -148,15 +148,32 @@ std::vector<Solid> collectSolids(const Complex& complex)
 
 /// The label function of the domain. Each thread gets its own field evaluators (FieldEvaluator is
 /// not thread safe); CGAL copies the function object, so copies share this oracle.
+///
+/// Mesh_3 calls it millions of times (circumcentres of new cells, both ends of every dual segment,
+/// every bisection step; perturbation and exudation redo much of that), so it avoids work a plain
+/// C++ lambda would not do: a grid of blocks over the domain records, per solid, whether interval
+/// arithmetic proves the block inside or outside it (most circumcentres lie in such blocks and
+/// need no field evaluation), solids are tried by decreasing priority (a point inside the highest
+/// one needs no lower one), and the thread's evaluators are found through a thread_local cache
+/// instead of a lookup in the thread-specific table. The labels are those of plain evaluation.
 class Labeller
 {
 public:
-  Labeller(
-    const std::vector<Solid>& solids, double overlapTolerance, std::function<bool(double)> progress)
+  Labeller(const std::vector<Solid>& solids, const Box3& domain, double overlapTolerance,
+    std::function<bool(double)> progress)
     : solids_(solids)
     , tolerance_(overlapTolerance)
     , progress_(std::move(progress))
+    , serial_(nextSerial())
   {
+    order_.resize(solids_.size());
+    for (std::size_t i = 0; i < order_.size(); ++i)
+    {
+      order_[i] = i;
+    }
+    std::stable_sort(order_.begin(), order_.end(),
+      [&](std::size_t a, std::size_t b) { return solids_[a].priority > solids_[b].priority; });
+    certify(domain);
   }
 
   /// 0 outside every solid, else the 1-based index of the solid holding p.
@@ -167,23 +184,25 @@ public:
     {
       throw frep::Cancelled();
     }
+    const std::uint8_t* known = blockStates(p);
     int best = -1;
     double bestDepth = -1;
-    for (std::size_t i = 0; i < solids_.size(); ++i)
+    for (const std::size_t i : order_)
     {
       const Solid& s = solids_[i];
-      if (!inBox(p, s.box) || !inside(l, i, p))
+      if (best >= 0 && s.priority < solids_[best].priority)
+      {
+        break; // only lower priorities left
+      }
+      const std::uint8_t state = known ? known[i] : kUnknown;
+      if (state == kOutside || (state == kUnknown && (!inBox(p, s.box) || !inside(l, i, p))))
       {
         continue;
       }
-      if (best < 0 || s.priority > solids_[best].priority)
+      if (best < 0)
       {
         best = static_cast<int>(i);
         bestDepth = -1;
-        continue;
-      }
-      if (s.priority < solids_[best].priority)
-      {
         continue;
       }
       // Equal priority: fine on a shared boundary (both depths about 0), an error inside both.
@@ -194,8 +213,10 @@ public:
       const double d = depth(l, i, p);
       if (d > tolerance_ && bestDepth > tolerance_)
       {
-        throw std::invalid_argument("cells '" + solids_[best].name + "' and '" + s.name +
-          "' overlap at " + pointText(p) + " and have the same priority (" +
+        const std::size_t first = std::min(static_cast<std::size_t>(best), i);
+        const std::size_t second = std::max(static_cast<std::size_t>(best), i);
+        throw std::invalid_argument("cells '" + solids_[first].name + "' and '" +
+          solids_[second].name + "' overlap at " + pointText(p) + " and have the same priority (" +
           std::to_string(s.priority) + "); give one of them a higher priority");
       }
       if (d > bestDepth)
@@ -210,14 +231,36 @@ public:
   void setPhase(double fraction) { phase_ = fraction; }
 
 private:
+  static constexpr std::uint8_t kUnknown = 0;
+  static constexpr std::uint8_t kInside = 1;
+  static constexpr std::uint8_t kOutside = 2;
+
   struct Local
   {
     std::vector<std::vector<std::unique_ptr<frep::FieldEvaluator>>> evaluators;
     std::uint64_t calls = 0;
   };
 
+  static std::uint64_t nextSerial()
+  {
+    static std::atomic<std::uint64_t> serial{ 0 };
+    return ++serial;
+  }
+
   Local& local()
   {
+    // The serial, not the address, names the oracle: a later Labeller may reuse this one's
+    // address, never its serial.
+    struct Cache
+    {
+      std::uint64_t owner = 0;
+      Local* local = nullptr;
+    };
+    thread_local Cache cache;
+    if (cache.owner == serial_)
+    {
+      return *cache.local;
+    }
     Local& l = local_.local();
     if (l.evaluators.empty())
     {
@@ -231,7 +274,112 @@ private:
         l.evaluators.push_back(std::move(e));
       }
     }
+    cache = { serial_, &l };
     return l;
+  }
+
+  /// Per block and solid: inside or outside for every point of the block (its box padded by a
+  /// hair, so rounding in the block index cannot matter), or unknown.
+  void certify(const Box3& domain)
+  {
+    // About 32 blocks along the longest side, fewer when there are many solids.
+    double longest = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      longest = std::max(longest, domain.hi[a] - domain.lo[a]);
+    }
+    const double perSide =
+      std::clamp(std::cbrt(4e6 / static_cast<double>(solids_.size())), 1.0, 32.0);
+    if (!(longest > 0) || !std::isfinite(longest))
+    {
+      return;
+    }
+    const double step = longest / perSide;
+    for (int a = 0; a < 3; ++a)
+    {
+      gridLo_[a] = domain.lo[a];
+      blocks_[a] = std::max(1, static_cast<int>(std::ceil((domain.hi[a] - domain.lo[a]) / step)));
+    }
+    gridStep_ = step;
+    const std::size_t count =
+      static_cast<std::size_t>(blocks_[0]) * std::size_t(blocks_[1]) * std::size_t(blocks_[2]);
+    states_.assign(count * solids_.size(), kUnknown);
+    const double hair = 1e-9 * step;
+    for (std::size_t i = 0; i < solids_.size(); ++i)
+    {
+      const Solid& s = solids_[i];
+      std::vector<std::unique_ptr<frep::FieldEvaluator>> fields;
+      for (const FieldPtr& f : s.inside)
+      {
+        fields.push_back(f->evaluator());
+      }
+      for (int z = 0; z < blocks_[2]; ++z)
+      {
+        for (int y = 0; y < blocks_[1]; ++y)
+        {
+          for (int x = 0; x < blocks_[0]; ++x)
+          {
+            const int at[3] = { x, y, z };
+            Box3 b;
+            bool meetsBox = true, inBounds = true;
+            for (int a = 0; a < 3; ++a)
+            {
+              b.lo[a] = gridLo_[a] + at[a] * step - hair;
+              b.hi[a] = gridLo_[a] + (at[a] + 1) * step + hair;
+              meetsBox = meetsBox && b.hi[a] >= s.box.lo[a] && b.lo[a] <= s.box.hi[a];
+              inBounds = inBounds && b.lo[a] >= s.box.lo[a] && b.hi[a] <= s.box.hi[a];
+            }
+            std::uint8_t state = kUnknown;
+            if (!meetsBox)
+            {
+              state = kOutside;
+            }
+            else
+            {
+              bool allInside = inBounds;
+              for (auto& f : fields)
+              {
+                const frep::Interval v = f->bound(b);
+                if (v.negative() || (v.empty() && v.maybeNaN))
+                {
+                  state = kOutside; // negative or NaN everywhere: not >= 0 anywhere
+                  break;
+                }
+                allInside = allInside && !v.maybeNaN && !v.empty() && v.lo >= 0;
+              }
+              if (state == kUnknown && allInside)
+              {
+                state = kInside;
+              }
+            }
+            const std::size_t block = (std::size_t(z) * std::size_t(blocks_[1]) + std::size_t(y)) *
+                std::size_t(blocks_[0]) +
+              std::size_t(x);
+            states_[block * solids_.size() + i] = state;
+          }
+        }
+      }
+    }
+  }
+
+  /// The states of p's block (one per solid), or nullptr outside the grid.
+  const std::uint8_t* blockStates(const Point3& p) const
+  {
+    if (states_.empty())
+    {
+      return nullptr;
+    }
+    std::size_t block = 0;
+    for (int a = 2; a >= 0; --a)
+    {
+      const double u = (p[a] - gridLo_[a]) / gridStep_;
+      if (!(u >= 0) || !(u < blocks_[a]))
+      {
+        return nullptr;
+      }
+      block = block * std::size_t(blocks_[a]) + static_cast<std::size_t>(u);
+    }
+    return &states_[block * solids_.size()];
   }
 
   static bool inside(Local& l, std::size_t i, const Point3& p)
@@ -262,9 +410,15 @@ private:
   }
 
   const std::vector<Solid>& solids_;
+  std::vector<std::size_t> order_;
   double tolerance_;
   std::function<bool(double)> progress_;
   double phase_ = 0;
+  std::uint64_t serial_;
+  Point3 gridLo_{ 0, 0, 0 };
+  double gridStep_ = 1;
+  int blocks_[3] = { 0, 0, 0 };
+  std::vector<std::uint8_t> states_;
   tbb::enumerable_thread_specific<Local> local_;
 };
 
@@ -321,6 +475,169 @@ void checkOverlaps(const std::vector<Solid>& solids, Labeller& labeller, double 
       }
     }
   }
+}
+
+// --- 2D cells inside solids ------------------------------------------------------------------
+//
+// A labelled domain only has surfaces where the label changes, so a patch {G = 0, H >= 0} inside
+// a solid is made one: the points of the solid with G < 0 and every H >= 0 (within the patch's
+// box) get a sub-label, and Mesh_3 meshes the interface {G = 0, H >= 0} between the solid's label
+// and the sub-label. The price is the rest of that interface, the walls {H = 0, G < 0} from the
+// patch's rim to the solid's boundary: faces inside the solid no one asked for (harmless: both
+// sides keep the solid's cell and material). The rim and the walls' edges are protected so the
+// patch ends cleanly at its rim.
+
+/// A 2D implicit cell that passes through the interior of some solid.
+struct Patch
+{
+  std::string name;
+  FieldPtr carrier;
+  std::vector<FieldPtr> trims;
+  /// The patch's bounds, padded, and unbounded along axes the patch is flat in (its own bounds
+  /// there only say where its plane is, they must not cut the sub-label's region short).
+  Box3 region;
+  /// The solids (indices) it passes through.
+  std::vector<std::size_t> solids;
+};
+
+/// At most this many patches: the label of a point holds one bit per patch.
+constexpr std::size_t kMaxPatches = 16;
+
+/// The sub-label bits of a point: bit k when p is on the negative side of patch k's carrier
+/// within its trims and region. Thread-local evaluators, as in Labeller.
+class PatchSides
+{
+public:
+  explicit PatchSides(const std::vector<Patch>& patches)
+    : patches_(patches)
+  {
+  }
+
+  int mask(const Point3& p)
+  {
+    Local& l = local_.local();
+    if (l.carriers.empty())
+    {
+      for (const Patch& pa : patches_)
+      {
+        l.carriers.push_back(pa.carrier->evaluator());
+        std::vector<std::unique_ptr<frep::FieldEvaluator>> t;
+        for (const FieldPtr& f : pa.trims)
+        {
+          t.push_back(f->evaluator());
+        }
+        l.trims.push_back(std::move(t));
+      }
+    }
+    int m = 0;
+    for (std::size_t k = 0; k < patches_.size(); ++k)
+    {
+      if (!inBox(p, patches_[k].region) || !(l.carriers[k]->value(p) < 0))
+      {
+        continue;
+      }
+      bool in = true;
+      for (auto& t : l.trims[k])
+      {
+        in = in && t->value(p) >= 0;
+      }
+      m |= in ? 1 << k : 0;
+    }
+    return m;
+  }
+
+private:
+  struct Local
+  {
+    std::vector<std::unique_ptr<frep::FieldEvaluator>> carriers;
+    std::vector<std::vector<std::unique_ptr<frep::FieldEvaluator>>> trims;
+  };
+  const std::vector<Patch>& patches_;
+  tbb::enumerable_thread_specific<Local> local_;
+};
+
+/// The implicit 2D cells some of whose points lie at least `margin` inside a solid (the label is
+/// the same there and at `margin` in 14 directions): cells on a boundary or an interface are
+/// already surfaces of the domain. Mapped and explicit 2D cells are not inserted (no carrier to
+/// split by).
+std::vector<Patch> collectPatches(const Complex& complex, const std::vector<Solid>& solids,
+  Labeller& labeller, const TetraOptions& options)
+{
+  static const int directions[14][3] = { { 1, 0, 0 }, { -1, 0, 0 }, { 0, 1, 0 }, { 0, -1, 0 },
+    { 0, 0, 1 }, { 0, 0, -1 }, { 1, 1, 1 }, { 1, 1, -1 }, { 1, -1, 1 }, { 1, -1, -1 }, { -1, 1, 1 },
+    { -1, 1, -1 }, { -1, -1, 1 }, { -1, -1, -1 } };
+  const double margin = 0.5 * options.size;
+  std::vector<Patch> patches;
+  for (CellId id : complex.cellsOfDimension(2))
+  {
+    const Cell& c = complex.cell(id);
+    const auto* g = std::get_if<complex::ImplicitGeometry>(&c.geometry);
+    if (!g || g->carriers.size() != 1)
+    {
+      continue;
+    }
+    complex::DiscretizationOptions d;
+    d.featureSize = options.size / 2;
+    d.threads = options.threads;
+    const discretize::SurfaceMesh mesh = complex::discretizeCell(complex, id, d).surface;
+    std::vector<bool> through(solids.size(), false);
+    Box3 extent{ { std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                   std::numeric_limits<double>::infinity() },
+      { -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+        -std::numeric_limits<double>::infinity() } };
+    for (const Point3& p : mesh.points)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        extent.lo[a] = std::min(extent.lo[a], p[a]);
+        extent.hi[a] = std::max(extent.hi[a], p[a]);
+      }
+      const int label = labeller.label(p);
+      bool inside = label > 0;
+      for (int k = 0; k < 14 && inside; ++k)
+      {
+        const double scale = k < 6 ? margin : margin / std::sqrt(3.0);
+        inside = labeller.label({ p[0] + scale * directions[k][0], p[1] + scale * directions[k][1],
+                   p[2] + scale * directions[k][2] }) == label;
+      }
+      if (inside)
+      {
+        through[static_cast<std::size_t>(label - 1)] = true;
+      }
+    }
+    Patch patch;
+    for (std::size_t i = 0; i < solids.size(); ++i)
+    {
+      if (through[i])
+      {
+        patch.solids.push_back(i);
+      }
+    }
+    if (patch.solids.empty())
+    {
+      continue;
+    }
+    patch.name = c.name;
+    patch.carrier = g->carriers[0];
+    patch.trims = g->inside;
+    patch.region = padded(g->bounds, options.size);
+    for (int a = 0; a < 3; ++a)
+    {
+      if (extent.hi[a] - extent.lo[a] < 0.5 * (g->bounds.hi[a] - g->bounds.lo[a]))
+      {
+        patch.region.lo[a] = -std::numeric_limits<double>::infinity();
+        patch.region.hi[a] = std::numeric_limits<double>::infinity();
+      }
+    }
+    patches.push_back(std::move(patch));
+  }
+  if (patches.size() > kMaxPatches)
+  {
+    throw std::invalid_argument("the CGAL backend inserts at most " + std::to_string(kMaxPatches) +
+      " 2D cells inside solids; this complex has " + std::to_string(patches.size()) + " (first '" +
+      patches.front().name + "'): use the TetGen backend");
+  }
+  return patches;
 }
 
 // --- feature curves ---------------------------------------------------------------------------
@@ -554,7 +871,7 @@ std::vector<Polyline> mergeFeatures(
 }
 
 std::vector<Polyline> featureCurves(const Complex& complex, const std::vector<Solid>& solids,
-  const Box3& domainBox, const TetraOptions& options)
+  const std::vector<Patch>& patches, const Box3& domainBox, const TetraOptions& options)
 {
   const double size = options.size;
   const double step = size / 4;
@@ -637,6 +954,67 @@ std::vector<Polyline> featureCurves(const Complex& complex, const std::vector<So
           }
           traceFeature(
             a.inside[k], b.inside[m], trims, padded(o, pad), step, options.threads, candidates);
+        }
+      }
+    }
+  }
+  // The rims of the 2D cells inside solids, and the edges of their sub-labels' walls (where two
+  // walls meet, where a wall meets the solid's boundary).
+  for (const Patch& pa : patches)
+  {
+    const FieldPtr below = frep::negatedField(pa.carrier);
+    for (const std::size_t si : pa.solids)
+    {
+      const Solid& s = solids[si];
+      Box3 o;
+      for (int ax = 0; ax < 3; ++ax)
+      {
+        o.lo[ax] = std::max(s.box.lo[ax], pa.region.lo[ax]);
+        o.hi[ax] = std::min(s.box.hi[ax], pa.region.hi[ax]);
+      }
+      if (!o.valid())
+      {
+        continue;
+      }
+      o = padded(o, pad);
+      auto others = [&](const std::vector<FieldPtr>& fields, std::size_t skip)
+      {
+        std::vector<FieldPtr> out;
+        for (std::size_t r = 0; r < fields.size(); ++r)
+        {
+          if (r != skip)
+          {
+            out.push_back(fields[r]);
+          }
+        }
+        return out;
+      };
+      for (std::size_t j = 0; j < pa.trims.size(); ++j)
+      {
+        std::vector<FieldPtr> trims = others(pa.trims, j);
+        trims.insert(trims.end(), s.inside.begin(), s.inside.end());
+        traceFeature(pa.carrier, pa.trims[j], trims, o, step, options.threads, candidates);
+        for (std::size_t k = j + 1; k < pa.trims.size(); ++k)
+        {
+          std::vector<FieldPtr> t2;
+          for (std::size_t r = 0; r < pa.trims.size(); ++r)
+          {
+            if (r != j && r != k)
+            {
+              t2.push_back(pa.trims[r]);
+            }
+          }
+          t2.push_back(below);
+          t2.insert(t2.end(), s.inside.begin(), s.inside.end());
+          traceFeature(pa.trims[j], pa.trims[k], t2, o, step, options.threads, candidates);
+        }
+        for (std::size_t m = 0; m < s.inside.size(); ++m)
+        {
+          std::vector<FieldPtr> t3 = others(pa.trims, j);
+          t3.push_back(below);
+          const auto rest = others(s.inside, m);
+          t3.insert(t3.end(), rest.begin(), rest.end());
+          traceFeature(pa.trims[j], s.inside[m], t3, o, step, options.threads, candidates);
         }
       }
     }
@@ -763,7 +1141,11 @@ std::vector<std::vector<Point3>> cgalFeatureCurves(
 {
   checkOptions(options);
   const auto solids = collectSolids(complex);
-  return featureCurves(complex, solids, domainBox(solids), options);
+  const Box3 box = domainBox(solids);
+  Labeller labeller(
+    solids, padded(box, 0.02 * diagonal(box) + options.size), 1e-3 * options.size, {});
+  const auto patches = collectPatches(complex, solids, labeller, options);
+  return featureCurves(complex, solids, patches, box, options);
 }
 
 TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& options)
@@ -789,22 +1171,30 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
 
   const Box3 box = domainBox(solids);
   const double diag = diagonal(box);
-  auto labeller = std::make_shared<Labeller>(solids, 1e-3 * options.size, options.progress);
+  // The domain's box: a little larger than the cells' (so that faces on the cells' bounds are
+  // seen as surfaces).
+  const Box3 outer = padded(box, 0.02 * diag + options.size);
+  auto labeller = std::make_shared<Labeller>(solids, outer, 1e-3 * options.size, options.progress);
   checkOverlaps(solids, *labeller, options.size);
-  const std::vector<Polyline> features = featureCurves(complex, solids, box, options);
+  const std::vector<Patch> patches = collectPatches(complex, solids, *labeller, options);
+  const std::vector<Polyline> features = featureCurves(complex, solids, patches, box, options);
   report(options, 0.1);
 
-  // The domain: the label function, a box a little larger than the cells' (so that faces on the
-  // cells' bounds are seen as surfaces), bisection to 1e-10 of the diagonal.
-  const Box3 outer = padded(box, 0.02 * diag + options.size);
+  // The domain: the label function, the outer box, bisection to 1e-10 of the diagonal.
   CGAL::Random rng(0);
   if (options.deterministic)
   {
     CGAL::get_default_random() = CGAL::Random(0);
   }
-  std::function<int(const K::Point_3&)> function = [labeller](const K::Point_3& p)
+  // Labels above the solids' count are sub-labels: solid (label - 1) % n + 1 on the negative
+  // sides of the patches in bits (label - 1) / n.
+  const int n = static_cast<int>(solids.size());
+  auto sides = patches.empty() ? nullptr : std::make_shared<PatchSides>(patches);
+  std::function<int(const K::Point_3&)> function = [labeller, sides, n](const K::Point_3& p)
   {
-    return labeller->label({ p.x(), p.y(), p.z() });
+    const Point3 q{ p.x(), p.y(), p.z() };
+    const int label = labeller->label(q);
+    return label > 0 && sides ? label + n * sides->mask(q) : label;
   };
   Domain domain(function,
     K::Iso_cuboid_3(K::Point_3(outer.lo[0], outer.lo[1], outer.lo[2]),
@@ -862,26 +1252,38 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
     mesh.materialNames.push_back(s.name);
   }
   const Tr& tr = c3t3.triangulation();
-  std::unordered_map<const void*, std::uint32_t> index;
+  // Vertices are found by their time stamps (unique, below the number of vertices ever inserted):
+  // an array lookup instead of a hash map that missed the cache four times per tetrahedron.
+  std::size_t stamps = 0;
+  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v)
+  {
+    stamps = std::max(stamps, v->time_stamp() + 1);
+  }
+  constexpr std::uint32_t unused = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> index(stamps, unused);
+  mesh.tetrahedra.reserve(c3t3.number_of_cells_in_complex());
+  mesh.cells.reserve(c3t3.number_of_cells_in_complex());
+  mesh.materials.reserve(c3t3.number_of_cells_in_complex());
   for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
   {
-    const int label = static_cast<int>(c3t3.subdomain_index(c));
-    if (label < 1 || static_cast<std::size_t>(label) > solids.size())
+    const int subLabel = static_cast<int>(c3t3.subdomain_index(c));
+    if (subLabel < 1)
     {
       continue;
     }
+    const int label = (subLabel - 1) % n + 1;
     std::array<std::uint32_t, 4> tet{};
     for (int k = 0; k < 4; ++k)
     {
-      const auto v = c->vertex(k);
-      const auto [it, added] = index.emplace(&*v, static_cast<std::uint32_t>(mesh.points.size()));
-      if (added)
+      std::uint32_t& i = index[c->vertex(k)->time_stamp()];
+      if (i == unused)
       {
+        i = static_cast<std::uint32_t>(mesh.points.size());
         const auto& wp = tr.point(c, k);
         mesh.points.push_back(
           { CGAL::to_double(wp.x()), CGAL::to_double(wp.y()), CGAL::to_double(wp.z()) });
       }
-      tet[k] = it->second;
+      tet[k] = i;
     }
     const Point3 a = mesh.points[tet[0]];
     const Point3 e1 = sub(mesh.points[tet[1]], a);
@@ -896,6 +1298,24 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
     mesh.tetrahedra.push_back(tet);
     mesh.cells.push_back(solids[static_cast<std::size_t>(label - 1)].id);
     mesh.materials.push_back(label);
+  }
+  // A solid with no tetrahedron would silently be missing from the mesh (and from a solver's
+  // element sets): refuse it by name.
+  std::vector<bool> meshed(solids.size(), false);
+  for (const std::int32_t m : mesh.materials)
+  {
+    meshed[static_cast<std::size_t>(m - 1)] = true;
+  }
+  for (std::size_t i = 0; i < solids.size(); ++i)
+  {
+    if (!meshed[i])
+    {
+      std::ostringstream s;
+      s << "cell '" << solids[i].name << "' has no volume: no tetrahedron of it at size "
+        << options.size << " (is it empty"
+        << (solids.size() > 1 ? ", or covered by cells of higher priority" : "") << "?)";
+      throw std::invalid_argument(s.str());
+    }
   }
   report(options, 1);
   return mesh;

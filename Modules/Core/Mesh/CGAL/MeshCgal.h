@@ -7,8 +7,16 @@
 // (among the 3D cells, ascending id) of the cell that holds it (bounds and every inside field
 // >= 0), the highest Cell::priority winning where cells overlap. Curves are protected as mesh
 // edges: the 1D cells, the creases of each solid (where two of its inside fields vanish) and the
-// curves where two solids' boundaries meet. 2D cells are not inserted as internal surfaces (a
-// labelled domain only has surfaces where the label changes); explicit (B) 3D cells are refused.
+// curves where two solids' boundaries meet. Explicit (B) 3D cells are refused.
+//
+// 2D implicit cells {G = 0, H >= 0} that pass through a solid become internal surfaces: a
+// labelled domain only has surfaces where the label changes, so the solid's points with G < 0
+// and every H >= 0 (within the 2D cell's bounds, padded by size, unbounded along axes the cell
+// is flat in) get a sub-label that is mapped back to the solid's cell and material in the
+// output. Mesh_3 then meshes {G = 0, H >= 0} (tetrahedra on both sides share faces on it), and
+// also the walls {H = 0, G < 0} from its rim to the solid's boundary (extra faces inside the
+// solid, with the solid's label on both sides); the rim and the walls' edges are protected. At
+// most 16 such cells; mapped and explicit 2D cells are not inserted (use the TetGen backend).
 
 #include "Mesh/TetMesh.h"
 
@@ -24,7 +32,8 @@ namespace ictk::mesh
 /// options.deterministic: no perturbation or exudation and fixed seeds (identical output run to
 /// run, but slivers remain: minimum dihedral angles near 0); otherwise perturbation and
 /// exudation aim at options.minDihedralDegrees.
-/// Throws std::invalid_argument for a 3D cell that is not implicit or not bounded, for
+/// Throws std::invalid_argument for a 3D cell that is not implicit or not bounded, one the mesh
+/// has no tetrahedron of (no volume; naming it), more than 16 2D cells inside solids, for
 /// overlapping cells of equal priority (naming both and the point), or for an estimate above
 /// options.maxTetrahedra (giving the estimate); frep::Cancelled when options.progress asks to
 /// stop.

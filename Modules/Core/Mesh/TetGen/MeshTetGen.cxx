@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Mesh/TetGen/MeshTetGen.h"
 
+#include "Complex/Discretization.h"
 #include "FRep/Expr.h"
 #include "FRep/Sampling.h"
 #include "FRep/Tape.h"
@@ -11,6 +12,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <stdexcept>
@@ -132,9 +135,110 @@ void checkBudget(double estimate, const TetraOptions& o)
   }
 }
 
-} // namespace
+/// The label of the multi-material surface at a point (the solid of highest priority whose
+/// field is >= 0, ties to the lower index), evaluated directly on the fields.
+class Labels
+{
+public:
+  Labels(const std::vector<frep::FieldPtr>& fields, const std::vector<double>& priorities)
+    : priorities_(priorities)
+  {
+    for (const auto& f : fields)
+    {
+      evaluators_.push_back(f->evaluator());
+    }
+  }
 
-TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, int materials,
+  int operator()(const Point3& p)
+  {
+    int best = 0;
+    for (std::size_t i = 0; i < evaluators_.size(); ++i)
+    {
+      if (evaluators_[i]->value(p) >= 0 &&
+        (best == 0 || priorities_[i] > priorities_[std::size_t(best - 1)]))
+      {
+        best = static_cast<int>(i) + 1;
+      }
+    }
+    return best;
+  }
+
+private:
+  std::vector<std::unique_ptr<frep::FieldEvaluator>> evaluators_;
+  std::vector<double> priorities_;
+};
+
+/// The parts of the complex's 2D cells that lie inside the solids, as triangles TetGen must keep
+/// as faces. The multi-material surface is only known to lie within a fraction of a grid cell of
+/// the exact interfaces, and a facet that crossed or touched it would make the PLC
+/// self-intersecting (TetGen error 3): so only triangles whose corners keep the same label at
+/// `margin` in 14 directions are kept, and a 2D cell that reaches a solid's boundary stops about
+/// `margin` short of it. 2D cells on a boundary or interface give nothing.
+discretize::SurfaceMesh internalSurfaces(const complex::Complex& complex, Labels& labels,
+  double size, double margin, int threads, std::size_t& cellsUsed)
+{
+  static const int directions[14][3] = { { 1, 0, 0 }, { -1, 0, 0 }, { 0, 1, 0 }, { 0, -1, 0 },
+    { 0, 0, 1 }, { 0, 0, -1 }, { 1, 1, 1 }, { 1, 1, -1 }, { 1, -1, 1 }, { 1, -1, -1 }, { -1, 1, 1 },
+    { -1, 1, -1 }, { -1, -1, 1 }, { -1, -1, -1 } };
+  discretize::SurfaceMesh out;
+  cellsUsed = 0;
+  for (const complex::CellId id : complex.cellsOfDimension(2))
+  {
+    complex::DiscretizationOptions d;
+    // Half the size: the kept triangles' corners then hold every point of them within the
+    // margin's reach.
+    d.featureSize = size / 2;
+    d.threads = threads;
+    const discretize::SurfaceMesh patch = complex::discretizeCell(complex, id, d).surface;
+    std::vector<int> safe(patch.points.size(), -1); // -1 unknown, 0 no, 1 yes
+    auto isSafe = [&](std::uint32_t v)
+    {
+      if (safe[v] < 0)
+      {
+        const Point3& p = patch.points[v];
+        const int label = labels(p);
+        bool ok = label > 0;
+        for (int k = 0; k < 14 && ok; ++k)
+        {
+          const double scale = k < 6 ? margin : margin / std::sqrt(3.0);
+          const Point3 q{ p[0] + scale * directions[k][0], p[1] + scale * directions[k][1],
+            p[2] + scale * directions[k][2] };
+          ok = labels(q) == label;
+        }
+        safe[v] = ok ? 1 : 0;
+      }
+      return safe[v] == 1;
+    };
+    std::vector<std::int64_t> index(patch.points.size(), -1);
+    const std::size_t before = out.triangles.size();
+    for (const auto& t : patch.triangles)
+    {
+      if (!isSafe(t[0]) || !isSafe(t[1]) || !isSafe(t[2]))
+      {
+        continue;
+      }
+      std::array<std::uint32_t, 3> n{};
+      for (int c = 0; c < 3; ++c)
+      {
+        const std::uint32_t v = t[std::size_t(c)];
+        if (index[v] < 0)
+        {
+          index[v] = static_cast<std::int64_t>(out.points.size());
+          out.points.push_back(patch.points[v]);
+        }
+        n[std::size_t(c)] = static_cast<std::uint32_t>(index[v]);
+      }
+      out.triangles.push_back(n);
+    }
+    cellsUsed += out.triangles.size() > before ? 1 : 0;
+  }
+  return out;
+}
+
+/// TetGen on the surface, with `internal` triangles as extra facets. A region no region point
+/// reaches (closed off by internal facets) takes the label `labelAt` gives most of its volume.
+TetMesh runTetGen(const discretize::MaterialSurface& surface, int materials,
+  const discretize::SurfaceMesh* internal, const std::function<int(const Point3&)>& labelAt,
   const TetraOptions& o, TetGenReport* report)
 {
   checkSize(o);
@@ -145,21 +249,26 @@ TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, 
   const double estimate = estimateTetrahedra(labelledVolume(surface, materials), o.size);
   checkBudget(estimate, o);
 
+  const std::size_t surfacePoints = surface.points.size();
+  const std::size_t surfaceTriangles = surface.triangles.size();
+  const std::size_t points = surfacePoints + (internal ? internal->points.size() : 0);
+  const std::size_t facets = surfaceTriangles + (internal ? internal->triangles.size() : 0);
   tetgenio in, out;
   in.firstnumber = 0;
-  in.numberofpoints = static_cast<int>(surface.points.size());
-  in.pointlist = new REAL[surface.points.size() * 3];
-  for (std::size_t i = 0; i < surface.points.size(); ++i)
+  in.numberofpoints = static_cast<int>(points);
+  in.pointlist = new REAL[points * 3];
+  for (std::size_t i = 0; i < points; ++i)
   {
+    const Point3& p = i < surfacePoints ? surface.points[i] : internal->points[i - surfacePoints];
     for (int c = 0; c < 3; ++c)
     {
-      in.pointlist[3 * i + std::size_t(c)] = surface.points[i][std::size_t(c)];
+      in.pointlist[3 * i + std::size_t(c)] = p[std::size_t(c)];
     }
   }
-  in.numberoffacets = static_cast<int>(surface.triangles.size());
-  in.facetlist = new tetgenio::facet[surface.triangles.size()];
-  in.facetmarkerlist = new int[surface.triangles.size()];
-  for (std::size_t t = 0; t < surface.triangles.size(); ++t)
+  in.numberoffacets = static_cast<int>(facets);
+  in.facetlist = new tetgenio::facet[facets];
+  in.facetmarkerlist = new int[facets];
+  for (std::size_t t = 0; t < facets; ++t)
   {
     tetgenio::facet& f = in.facetlist[t];
     tetgenio::init(&f);
@@ -168,12 +277,17 @@ TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, 
     tetgenio::init(&f.polygonlist[0]);
     f.polygonlist[0].numberofvertices = 3;
     f.polygonlist[0].vertexlist = new int[3];
+    const bool inner = t >= surfaceTriangles;
     for (int c = 0; c < 3; ++c)
     {
-      f.polygonlist[0].vertexlist[c] = static_cast<int>(surface.triangles[t][std::size_t(c)]);
+      f.polygonlist[0].vertexlist[c] = inner
+        ? static_cast<int>(
+            surfacePoints + internal->triangles[t - surfaceTriangles][std::size_t(c)])
+        : static_cast<int>(surface.triangles[t][std::size_t(c)]);
     }
-    // The pair of labels, for TetGen's boundary markers.
-    in.facetmarkerlist[t] = surface.labels[t][0] * (materials + 1) + surface.labels[t][1];
+    // The pair of labels, for TetGen's boundary markers (internal facets: one past them all).
+    in.facetmarkerlist[t] = inner ? (materials + 1) * (materials + 1)
+                                  : surface.labels[t][0] * (materials + 1) + surface.labels[t][1];
   }
   int regions = 0, holes = 0;
   for (const auto& r : surface.regions)
@@ -214,6 +328,7 @@ TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, 
     report->estimate = estimate;
     report->surfacePoints = surface.points.size();
     report->surfaceTriangles = surface.triangles.size();
+    report->internalTriangles = internal ? internal->triangles.size() : 0;
   }
   if (o.progress && !o.progress(0.35))
   {
@@ -267,13 +382,55 @@ TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, 
       ? out.tetrahedronattributelist[t * std::size_t(out.numberoftetrahedronattributes)]
       : 0;
     const auto m = static_cast<std::int32_t>(std::lround(attribute));
-    if (m < 1 || m > materials)
+    if ((m < 1 || m > materials) && !labelAt)
     {
       throw std::runtime_error("TetGen backend: tetrahedron " + std::to_string(t) +
         " has region attribute " + number(attribute) + ", not a material");
     }
     mesh.materials[t] = m;
-    mesh.cells[t] = static_cast<complex::CellId>(m - 1);
+  }
+  // TetGen numbers the regions no region point reaches (those closed off by internal surfaces)
+  // itself, past the given attributes: each such region takes the label that holds most of its
+  // volume, sampled at the centroids.
+  std::map<std::int32_t, std::map<int, double>> votes;
+  for (std::size_t t = 0; t < tets; ++t)
+  {
+    const std::int32_t m = mesh.materials[t];
+    if (m >= 1 && m <= materials)
+    {
+      continue;
+    }
+    const auto& tet = mesh.tetrahedra[t];
+    Point3 centroid{ 0, 0, 0 };
+    for (const auto v : tet)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        centroid[std::size_t(c)] += mesh.points[v][std::size_t(c)] / 4;
+      }
+    }
+    votes[m][labelAt(centroid)] += orient(mesh.points, tet);
+  }
+  std::map<std::int32_t, std::int32_t> relabel;
+  for (const auto& [region, byLabel] : votes)
+  {
+    const auto best = std::max_element(byLabel.begin(), byLabel.end(),
+      [](const auto& a, const auto& b) { return a.second < b.second; });
+    if (best->first < 1 || best->first > materials)
+    {
+      throw std::runtime_error("TetGen backend: a region closed off by internal surfaces lies "
+                               "outside every solid");
+    }
+    relabel[region] = best->first;
+  }
+  for (std::size_t t = 0; t < tets; ++t)
+  {
+    const auto r = relabel.find(mesh.materials[t]);
+    if (r != relabel.end())
+    {
+      mesh.materials[t] = r->second;
+    }
+    mesh.cells[t] = static_cast<complex::CellId>(mesh.materials[t] - 1);
   }
   for (int m = 1; m <= materials; ++m)
   {
@@ -284,6 +441,14 @@ TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, 
     throw frep::Cancelled();
   }
   return mesh;
+}
+
+} // namespace
+
+TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, int materials,
+  const TetraOptions& o, TetGenReport* report)
+{
+  return runTetGen(surface, materials, nullptr, {}, o, report);
 }
 
 TetMesh tetrahedralizeTetGen(
@@ -359,10 +524,32 @@ TetMesh tetrahedralizeTetGen(
       "' overlap (both hold " + point(v.point) + ") and have the same priority " +
       number(a.priority) + ": give one of them a higher priority");
   }
-  TetMesh mesh = tetrahedralizeSurfaceTetGen(surface, materials, o, report);
+  // A solid the grid finds no point of would silently be missing from the mesh (and from a
+  // solver's element sets): refuse it by name.
+  for (int m = 1; m <= materials; ++m)
+  {
+    const bool found = std::any_of(surface.regions.begin(), surface.regions.end(),
+      [&](const discretize::MaterialRegion& r) { return r.label == m; });
+    if (!found || !(discretize::materialVolume(surface, m) > 0))
+    {
+      const complex::Cell& c = complex.cell(ids[std::size_t(m - 1)]);
+      throw std::invalid_argument("TetGen backend: 3D cell '" + c.name +
+        "' has no volume: no point of its bounds is inside it" +
+        (priorities.size() > 1 ? " (or cells of higher priority cover it)" : std::string()) +
+        " at size " + number(o.size));
+    }
+  }
+  Labels labels(fields, priorities);
+  std::size_t internalCells = 0;
+  const discretize::SurfaceMesh internal =
+    internalSurfaces(complex, labels, o.size, 0.75 * o.size, o.threads, internalCells);
+  TetMesh mesh = runTetGen(
+    surface, materials, internal.triangles.empty() ? nullptr : &internal,
+    [&](const Point3& p) { return labels(p); }, o, report);
   if (report)
   {
     report->surfaceSeconds = surfaceSeconds;
+    report->internalCells = internalCells;
   }
   mesh.materialNames.clear();
   for (const auto id : ids)
