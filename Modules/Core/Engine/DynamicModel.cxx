@@ -234,6 +234,7 @@ struct DynamicModel::Impl
     const Instance& in, const std::string& kind, int depth) const;
   RelationSpec relationSpec(const Relation& r, bool dependency) const;
   void addParam(const std::string& owner, const ParamSpec& p);
+  Value initialValue(const ParamDecl& p);
   void buildStepper();
   dyn::DependencyGraph graph(std::size_t instance) const;
 
@@ -325,51 +326,14 @@ void DynamicModel::Impl::build()
         if (!cellIndex.count(def.name.text))
           buildCell(def);
   for (const ParamDecl& p : model.stateParameters)
-  {
     if (p.kind == ParamDecl::Kind::Typed)
     {
-      modelParams.push_back({ p.pos, p.name.text, {} });
+      modelParams.push_back({ p.pos, p.name.text, initialValue(p) });
       modelStateNames.push_back(p.name.text);
     }
-  }
   for (const ParamDecl& p : model.parameters)
     if (p.kind == ParamDecl::Kind::Typed)
-      modelParams.push_back({ p.pos, p.name.text, {} });
-  auto initial = [&](const ParamDecl& p)
-  {
-    const Value::Type t = typeOf(p.type.text);
-    EngineScope scope(*this, {}, kNone);
-    Value v;
-    if (t == Value::Type::Vec3)
-    {
-      Vec3 x{ 0, 0, 0 };
-      for (std::size_t i = 0; i < p.args.size() && i < 3; ++i)
-        x[i] = interpreter.evaluate(*p.args[i], scope).number;
-      return Value::vector(x);
-    }
-    if (!p.args.empty())
-      v = interpreter.evaluate(*p.args[0], scope);
-    switch (t)
-    {
-      case Value::Type::Real:
-        return Value::real(v.isNumber() || v.type == Value::Type::Bool ? v.number : 0.0);
-      case Value::Type::Int:
-        return Value::integer(v.isNumber() ? v.number : 0.0);
-      case Value::Type::Bool:
-        return Value::boolean(v.number != 0.0);
-      case Value::Type::String:
-        return Value::string(v.type == Value::Type::String ? v.text : std::string());
-      default:
-        return Value{};
-    }
-  };
-  {
-    std::size_t k = 0;
-    for (const auto* list : { &model.stateParameters, &model.parameters })
-      for (const ParamDecl& p : *list)
-        if (p.kind == ParamDecl::Kind::Typed)
-          modelParams[k++].initial = initial(p);
-  }
+      modelParams.push_back({ p.pos, p.name.text, initialValue(p) });
   for (const Instance& in : model.instances)
     buildInstance(in);
   // Cell parameters (they may be read by instances' initial values, so after the cells).
@@ -617,37 +581,9 @@ void DynamicModel::Impl::buildCell(const CellDef& def)
   // Parameters: a copy's own declarations replace the source's of the same name.
   for (const ParamDecl& p : def.parameters)
   {
-    ParamSpec spec{ p.pos, p.name.text, {} };
-    if (p.kind == ParamDecl::Kind::Init)
-    {
-      Vec3 x{ 0, 0, 0 };
-      for (std::size_t i = 0; i < p.args.size() && i < 3; ++i)
-        x[i] = interpreter.evaluate(*p.args[i], scope).number;
-      spec.initial = Value::vector(x);
-    }
-    else if (p.kind == ParamDecl::Kind::Typed)
-    {
-      const Value::Type t = p.array ? Value::Type::None : typeOf(p.type.text);
-      if (t == Value::Type::Vec3)
-      {
-        Vec3 x{ 0, 0, 0 };
-        for (std::size_t i = 0; i < p.args.size() && i < 3; ++i)
-          x[i] = interpreter.evaluate(*p.args[i], scope).number;
-        spec.initial = Value::vector(x);
-      }
-      else if (t == Value::Type::None)
-        spec.initial = Value{}; // arrays and transforms: they order dependencies only
-      else
-      {
-        const Value v = p.args.empty() ? Value::real(0.0) : interpreter.evaluate(*p.args[0], scope);
-        spec.initial = t == Value::Type::Real ? Value::real(v.number)
-          : t == Value::Type::Int             ? Value::integer(v.number)
-          : t == Value::Type::Bool            ? Value::boolean(v.number != 0.0)
-                                              : Value::string(v.text);
-      }
-    }
-    else
+    if (p.kind != ParamDecl::Kind::Init && p.kind != ParamDecl::Kind::Typed)
       continue;
+    const ParamSpec spec{ p.pos, p.name.text, initialValue(p) };
     auto same = std::find_if(
       c.params.begin(), c.params.end(), [&](const ParamSpec& q) { return q.name == spec.name; });
     if (same != c.params.end())
@@ -943,23 +879,6 @@ void DynamicModel::Impl::buildInstance(const Instance& in)
   s.containment = relationsOf(in, "containment", 0);
   s.dependency = relationsOf(in, "dependency", 0);
   EngineScope scope(*this, {}, kNone);
-  auto typed = [&](const ParamDecl& p)
-  {
-    const Value::Type t = p.array ? Value::Type::None : typeOf(p.type.text);
-    Value v = p.args.empty() ? Value::real(0.0) : interpreter.evaluate(*p.args[0], scope);
-    if (t == Value::Type::Vec3)
-    {
-      Vec3 x{ 0, 0, 0 };
-      for (std::size_t i = 0; i < p.args.size() && i < 3; ++i)
-        x[i] = interpreter.evaluate(*p.args[i], scope).number;
-      return Value::vector(x);
-    }
-    return t == Value::Type::Real ? Value::real(v.number)
-      : t == Value::Type::Int     ? Value::integer(v.number)
-      : t == Value::Type::Bool    ? Value::boolean(v.number != 0.0)
-      : t == Value::Type::String  ? Value::string(v.text)
-                                  : Value{};
-  };
   // Inherited from the template: parameters, reactions and the predicate, overridden by the
   // instance's own.
   if (!in.base.text.empty() && in.base.text != "TEMPLATE_IC")
@@ -978,7 +897,7 @@ void DynamicModel::Impl::buildInstance(const Instance& in)
   {
     if (p.kind == ParamDecl::Kind::Typed)
     {
-      s.params.push_back({ p.pos, p.name.text, typed(p) });
+      s.params.push_back({ p.pos, p.name.text, initialValue(p) });
       s.stateNames.push_back(p.name.text);
     }
     else if (p.kind == ParamDecl::Kind::Alias)
@@ -989,7 +908,7 @@ void DynamicModel::Impl::buildInstance(const Instance& in)
   }
   for (const ParamDecl& p : in.parameters)
     if (p.kind == ParamDecl::Kind::Typed)
-      s.params.push_back({ p.pos, p.name.text, typed(p) });
+      s.params.push_back({ p.pos, p.name.text, initialValue(p) });
   for (const Procedure& r : in.reactions)
   {
     s.reactions[reactionKey(r)] = &r;
@@ -1004,6 +923,44 @@ void DynamicModel::Impl::buildInstance(const Instance& in)
     s.predicate = &p;
   instanceIndex[s.name] = instances.size();
   instances.push_back(std::move(s));
+}
+
+// `name : TYPE(value)` or `translation(x, y, z)`: the initial value, of the declared type.
+// Arrays and transforms have none (they only order dependencies).
+Value DynamicModel::Impl::initialValue(const ParamDecl& p)
+{
+  EngineScope scope(*this, {}, kNone);
+  auto number = [&](std::size_t i)
+  {
+    const Value v = interpreter.evaluate(*p.args[i], scope);
+    if (!(v.isNumber() || v.type == Value::Type::Bool) || !std::isfinite(v.number))
+      fail(p.args[i]->pos, "the initial value of " + p.name.text + " must be a finite number");
+    return v.number;
+  };
+  const Value::Type t = p.kind == ParamDecl::Kind::Init ? Value::Type::Vec3
+    : p.array                                           ? Value::Type::None
+                                                        : typeOf(p.type.text);
+  switch (t)
+  {
+    case Value::Type::Vec3:
+    {
+      Vec3 x{ 0, 0, 0 };
+      for (std::size_t i = 0; i < p.args.size() && i < 3; ++i)
+        x[i] = number(i);
+      return Value::vector(x);
+    }
+    case Value::Type::Real:
+      return Value::real(p.args.empty() ? 0.0 : number(0));
+    case Value::Type::Int:
+      return Value::integer(p.args.empty() ? 0.0 : number(0));
+    case Value::Type::Bool:
+      return Value::boolean(!p.args.empty() && number(0) != 0.0);
+    case Value::Type::String:
+      return Value::string(
+        p.args.empty() ? std::string() : interpreter.evaluate(*p.args[0], scope).text);
+    default:
+      return Value{};
+  }
 }
 
 void DynamicModel::Impl::addParam(const std::string& owner, const ParamSpec& p)
