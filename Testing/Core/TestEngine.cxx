@@ -429,3 +429,33 @@ TEST(EngineEvents, TimeRejectedFromAReaction)
   EXPECT_EQ(rs[1].time, 0.5);
   EXPECT_EQ(rs[2].time, 1.0);
 }
+
+// Thesis 5.6: the egg contents' attribute (a HyperFun density, 1 at the yolk's centre, 0.3 in
+// the white) is bound to the cell and follows it: at t = 1 the contents' centre is at
+// (0, -1.7, 0), so the density there is 1 and 0.4 above it is 0.3 + 0.7 exp(-8) = 0.300235.
+TEST(EngineComplex, AttributesFollowTheirCell)
+{
+  DynamicModel m = load("andyhausen.icm");
+  m.advanceTo(1.0, 0.5);
+  const ictk::complex::Complex c = m.complex();
+  const auto cells = m.cells();
+  std::size_t contents = cells.size();
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    if (cells[i].name == "Egg_contents")
+      contents = i;
+  ASSERT_LT(contents, cells.size());
+  const auto& cell = c.cell(static_cast<ictk::complex::CellId>(contents));
+  ASSERT_EQ(cell.attributes.size(), 1u);
+  EXPECT_EQ(cell.attributes[0].attribute, "eggContentsAttr");
+  auto eval = cell.attributes[0].function->components[0]->evaluator();
+  double x[2] = { 0.0, 0.0 }, y[2] = { -1.7, -1.3 }, z[2] = { 0.0, 0.0 }, v[2];
+  eval->values(x, y, z, v, 2);
+  EXPECT_NEAR(v[0], 1.0, 1e-12);
+  EXPECT_NEAR(v[1], 0.3 + 0.7 * std::exp(-8.0), 1e-12);
+  // The external mapping of the liquid is named but has no function: not bound.
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    if (cells[i].name == "Liquid")
+    {
+      EXPECT_TRUE(c.cell(static_cast<ictk::complex::CellId>(i)).attributes.empty());
+    }
+}

@@ -93,6 +93,16 @@ struct RelationSpec
   bool hierarchical = false;
 };
 
+/// An attribute (thesis L864): a HyperFun function of the cell's local coordinates, or an
+/// external mapping known only by name (no function: it is not evaluated).
+struct AttributeSpec
+{
+  std::string name;
+  frep::TapePtr tape;
+  int dimension = 3;
+  std::string text;
+};
+
 struct InstanceSpec
 {
   std::string name;
@@ -107,6 +117,7 @@ struct InstanceSpec
   std::map<std::string, std::map<std::string, const Procedure*>> cellReactions;
   const Procedure* predicate = nullptr;
   std::set<std::string> reactsTo;
+  std::vector<std::pair<std::string, std::string>> attributeLinks; ///< (cell, attribute)
 };
 
 /// The structural state: what the parameter table cannot hold. Copied with every snapshot.
@@ -191,6 +202,7 @@ struct DynamicModel::Impl
   std::map<std::string, dyn::AnimationCurve> curves[4]; ///< per component x, y, z, and scalar
   std::set<std::string> curveNames;
   std::map<std::string, std::size_t> curveWidth;
+  std::map<std::string, AttributeSpec> attributes;
   std::vector<ParamSpec> modelParams;
   std::vector<std::string> modelStateNames;
   std::set<std::string> eventNames;
@@ -233,6 +245,9 @@ struct DynamicModel::Impl
   std::vector<RelationSpec> relationsOf(
     const Instance& in, const std::string& kind, int depth) const;
   RelationSpec relationSpec(const Relation& r, bool dependency) const;
+  void buildAttributes(const lang::icm::AttributesSection& section);
+  std::vector<std::pair<std::string, std::string>> attributeLinksOf(
+    const Instance& in, int depth) const;
   void addParam(const std::string& owner, const ParamSpec& p);
   Value initialValue(const ParamDecl& p);
   void buildStepper();
@@ -334,6 +349,11 @@ void DynamicModel::Impl::build()
   for (const ParamDecl& p : model.parameters)
     if (p.kind == ParamDecl::Kind::Typed)
       modelParams.push_back({ p.pos, p.name.text, initialValue(p) });
+  for (const auto& section : model.attributes)
+    buildAttributes(section);
+  for (const Instance& in : model.instances)
+    for (const auto& section : in.attributes)
+      buildAttributes(section);
   for (const Instance& in : model.instances)
     buildInstance(in);
   // Cell parameters (they may be read by instances' initial values, so after the cells).
@@ -865,6 +885,70 @@ std::vector<RelationSpec> DynamicModel::Impl::relationsOf(
   return out;
 }
 
+void DynamicModel::Impl::buildAttributes(const lang::icm::AttributesSection& section)
+{
+  for (const CellDef& d : section.defs)
+  {
+    AttributeSpec a;
+    a.name = d.name.text;
+    for (const Property& p : d.properties)
+      if (p.name == "mapping" && p.isHyperFun)
+      {
+        try
+        {
+          const lang::HyperFunModel hf = lang::readHyperFun(p.hyperFunText, file);
+          a.tape = frep::Tape::compile(hf.model.geometry().function());
+          a.dimension = hf.model.geometry().domain() == frep::Domain::XY ? 2 : 3;
+          a.text = hf.name;
+        }
+        catch (const lang::ParseError& e)
+        {
+          fail(p.hyperFunPos, std::string("in the hyperfun mapping: ") + e.what());
+        }
+      }
+    if (!attributes.count(a.name) || a.tape)
+      attributes[a.name] = a;
+  }
+  for (const auto& b : section.bindings)
+    if (!attributes.count(b.first.text))
+      attributes[b.first.text] = AttributeSpec{ b.first.text, nullptr, 3, b.second.text };
+}
+
+std::vector<std::pair<std::string, std::string>> DynamicModel::Impl::attributeLinksOf(
+  const Instance& in, int depth) const
+{
+  if (depth > 64)
+    fail(in.pos, "templates derive from each other in a cycle");
+  std::vector<std::pair<std::string, std::string>> out;
+  auto add = [&](const std::pair<std::string, std::string>& l)
+  {
+    if (std::find(out.begin(), out.end(), l) == out.end())
+      out.push_back(l);
+  };
+  if (!in.base.text.empty() && in.base.text != "TEMPLATE_IC")
+    if (const Instance* base = model.instance(in.base.text))
+      for (const auto& l : attributeLinksOf(*base, depth + 1))
+        add(l);
+  for (const auto& section : in.attributes)
+  {
+    for (const auto& u : section.uses)
+    {
+      std::vector<std::string> path;
+      if (pathOf(*u.what, path) && path.size() == 2 && path[1] == "ATTRIBUTES")
+        if (const Instance* src = model.instance(path[0]))
+          for (const auto& l : attributeLinksOf(*src, depth + 1))
+            add(l);
+    }
+    for (const Relation& r : section.links)
+    {
+      std::vector<std::string> cell;
+      if (r.ends.size() == 2 && pathOf(*r.ends[0], cell) && !cell.empty())
+        add({ cell[0], r.ends[1]->text });
+    }
+  }
+  return out;
+}
+
 void DynamicModel::Impl::buildInstance(const Instance& in)
 {
   InstanceSpec s;
@@ -878,6 +962,7 @@ void DynamicModel::Impl::buildInstance(const Instance& in)
   s.boundary = relationsOf(in, "boundary", 0);
   s.containment = relationsOf(in, "containment", 0);
   s.dependency = relationsOf(in, "dependency", 0);
+  s.attributeLinks = attributeLinksOf(in, 0);
   EngineScope scope(*this, {}, kNone);
   // Inherited from the template: parameters, reactions and the predicate, overridden by the
   // instance's own.
@@ -2046,6 +2131,31 @@ complex::Complex DynamicModel::complex() const
         m.fail(r.pos, std::string("boundary relation: ") + e.what());
       }
     }
+  // Attributes with a function follow their cell: evaluated in its local coordinates.
+  for (const auto& [cell, name] : in.attributeLinks)
+  {
+    auto a = m.attributes.find(name);
+    if (a == m.attributes.end() || !a->second.tape || !ids.count(cell))
+      continue;
+    Shape local;
+    local.cell = cell;
+    local.dimension = 3;
+    local.place = m.place(cell);
+    ShapePart part;
+    part.kind = ShapePart::Kind::Field;
+    part.field = frep::tapeField(a->second.tape);
+    part.fieldDimension = a->second.dimension;
+    // unbounded: the attribute is defined wherever its cell is
+    part.bounds = frep::Box3{ { -1e30, -1e30, -1e30 }, { 1e30, 1e30, 1e30 } };
+    local.parts.push_back(part);
+    auto fn = std::make_shared<complex::AttributeFunction>();
+    fn->name = name;
+    fn->components.push_back(worldField(local));
+    fn->text.push_back(a->second.text);
+    if (!cx.attributes().count(name))
+      cx.declareAttribute(name, complex::AttributeDefaults{ 1, { 0.0 }, { 0.0 } });
+    cx.bindAttribute(ids[cell], complex::AttributeBinding{ name, fn, 0.0 });
+  }
   for (const RelationSpec& r : in.containment)
     if (ids.count(r.master) && ids.count(r.dependent))
     {

@@ -2570,6 +2570,11 @@ private:
 
 // -------------------------------------------------------------------------------------------------
 
+frep::FieldPtr worldField(const Shape& s)
+{
+  return std::make_shared<ShapeField>(std::make_shared<const Shape>(s));
+}
+
 Affine Affine::fromTransform(const Vec3& translation, const Vec3& rotation, const Vec3& scale)
 {
   const double cx = std::cos(rotation[0]), sx = std::sin(rotation[0]);

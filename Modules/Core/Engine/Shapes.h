@@ -54,11 +54,11 @@ struct ShapePart
 {
   enum class Kind
   {
-    Point,     ///< points[0]                                           0D
-    Segment,   ///< points[0] -> points[1]                              1D
-    Polyline,  ///< points[0] -> ... -> points[n-1]                     1D
-    Arc,       ///< the circle |p| = radius from points[0] counter-clockwise (about +z) to
-               ///< points[1] (both projected onto the circle)                            1D
+    Point,           ///< points[0]                                           0D
+    Segment,         ///< points[0] -> points[1]                              1D
+    Polyline,        ///< points[0] -> ... -> points[n-1]                     1D
+    Arc,             ///< the circle |p| = radius from points[0] counter-clockwise (about +z) to
+                     ///< points[1] (both projected onto the circle)                            1D
     CircularSegment, ///< the region between that Arc and its chord points[1] -> points[0] 2D
     Rectangle, ///< [-size.x/2, size.x/2] x [-size.y/2, size.y/2] in z = 0                    2D
     Disk,      ///< |p| <= radius in z = 0                                                    2D
@@ -84,10 +84,10 @@ struct ShapePart
 /// A cell's shape placed in the world.
 struct Shape
 {
-  std::string cell;              ///< the cell's name, for error messages
-  int dimension = 3;             ///< the cell's declared dimension (0..3)
-  std::vector<ShapePart> parts;  ///< the union of its parts
-  Affine place;                  ///< local -> world (ignored by Blend / Union parts)
+  std::string cell;             ///< the cell's name, for error messages
+  int dimension = 3;            ///< the cell's declared dimension (0..3)
+  std::vector<ShapePart> parts; ///< the union of its parts
+  Affine place;                 ///< local -> world (ignored by Blend / Union parts)
 
   /// The signed field of a 2D/3D shape in world coordinates (>= 0 inside; for 2D shapes a
   /// function of (x, y), z ignored). Throws std::invalid_argument for 0D/1D shapes.
@@ -121,6 +121,10 @@ std::vector<Vec3> intersectionPoints(const Shape& a, const Shape& b, const Query
 double intersectionMeasure(const Shape& a, const Shape& b, const QueryOptions& o = {});
 /// The area (2D) or volume (3D) of a shape.
 double measure(const Shape& s, const QueryOptions& o = {});
+
+/// The world-space field of a 2D or 3D shape (>= 0 inside; the value Shape::value gives), with
+/// interval bounds and gradients, as a frep::Field (the inside field of toComplexCell's cells).
+frep::FieldPtr worldField(const Shape& s);
 
 /// The cell of an implicit complex that the placed shape stands for at this instant: implicit
 /// geometry for fields, disks, spheres, sectors, blends and unions (2D ones carried by z = 0);

@@ -833,6 +833,11 @@ private:
         shape(v, cells);
       }
     }
+    else if (p.name == "mapping" && p.isHyperFun)
+    {
+      // an attribute function written in HyperFun
+      hyperFun(p);
+    }
     else if (p.name == "mapping" || p.name == "deformation")
     {
       for (const ExprPtr& v : p.values)
