@@ -13,7 +13,11 @@
 //                         size 0.025, 2 threads (libfive: 4.74 s)
 //   flower-256            the discretisation of every cell of Data/Models/flower/flower.json at
 //                         1/256 of its size (surfaces, patches, traced curves, points)
+//   andyhausen-100        a 10-second, 100-step run of Data/Models/icm/andyhausen.icm with the
+//                         complex discretised at every step, time-coherent (issue 5); -full: the
+//                         same run re-meshing every cell of every frame
 #include "Bench.h"
+#include "BenchDynamics.h"
 #include "BenchScaling.h"
 
 #include "Complex/Discretization.h"
@@ -379,6 +383,55 @@ Result Flower(int divisions)
   return r;
 }
 
+/// The coherent run and the full re-meshing of the same frames, as two workloads.
+std::vector<Result> Andyhausen(int steps)
+{
+  const std::string path = std::string(ICTK_DATA_DIR) + "/Models/icm/andyhausen.icm";
+  const int threads = ThreadsOr(2);
+  // Every run loads the model afresh, so there is nothing for a warm-up run to warm.
+  // Meshes at 1/128 of the model's size: fine enough for the meshing to count, coarse enough for
+  // the full re-meshing to stay under a minute a run.
+  const int divisions = 128;
+  const DynamicRunTiming coherent =
+    TimeDynamicRun(path, 10.0, steps, divisions, true, Options.Runs, threads);
+  const DynamicRunTiming full =
+    TimeDynamicRun(path, 10.0, steps, divisions, false, Options.Runs, threads);
+  std::vector<Result> results;
+  for (const DynamicRunTiming* timing : { &coherent, &full })
+  {
+    Result r;
+    const bool isFull = timing == &full;
+    r.workload = "andyhausen-" + std::to_string(steps) + (isFull ? "-full" : "");
+    r.what = "a 10-second, " + std::to_string(steps) +
+      "-step run of the Andyhausen model, the complex discretised at every step at 1/128 of "
+      "its size" +
+      (isFull ? ", every cell re-meshed" : ", time-coherent");
+    r.threads = threads;
+    r.unit = "Mpoints/s";
+    r.allSeconds = timing->seconds;
+    r.cpuSeconds = timing->cpuSeconds;
+    r.seconds = Median(r.allSeconds);
+    r.work = static_cast<double>(timing->points);
+    r.details["frames"] = timing->frames;
+    r.details["points"] = timing->points;
+    r.details["feature_size"] = timing->featureSize;
+    r.details["engine_seconds"] = timing->engineSeconds;
+    r.details["mesh_seconds"] = timing->meshSeconds;
+    r.details["cells_computed"] = timing->computed;
+    r.details["cells_moved"] = timing->moved;
+    r.details["cells_reused"] = timing->reused;
+    r.details["instances"] = timing->instances;
+    if (!isFull)
+    {
+      r.details["full_remesh_seconds"] = Median(full.seconds);
+      r.details["coherence_speedup"] = Median(full.seconds) / r.seconds;
+      r.details["mesh_speedup"] = full.meshSeconds / timing->meshSeconds;
+    }
+    results.push_back(std::move(r));
+  }
+  return results;
+}
+
 nlohmann::json ToJson(const Result& r)
 {
   nlohmann::json j;
@@ -562,6 +615,15 @@ int RunBenchCommand()
   if (Selected("flower-" + std::to_string(flowerDivisions)))
   {
     report(Flower(flowerDivisions));
+  }
+  const int andyhausenSteps = Options.Quick ? 10 : 100;
+  const std::string andyhausen = "andyhausen-" + std::to_string(andyhausenSteps);
+  if (Selected(andyhausen) || Selected(andyhausen + "-full"))
+  {
+    for (Result& r : Andyhausen(andyhausenSteps))
+    {
+      report(std::move(r));
+    }
   }
   if (results.empty() && !Options.Only.empty())
   {

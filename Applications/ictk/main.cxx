@@ -5,6 +5,8 @@
 //   ictk eval MODEL --at x,y,z[,t]      value (and with --json gradient, normal, membership,
 //                                       attributes) at a point
 //   ictk sample MODEL -o out.vti        sample on a grid (.vti), optionally extract the surface
+//   ictk run MODEL.icm --time T0:T1:DT -o out.pvd
+//                                       run a dynamic complex, one .vtpc per frame (RunCommand.cxx)
 //
 // Every user error ends in one line "ictk: error: ..." on stderr and exit code 2; nothing is
 // left half-written (outputs go to a temporary file in the target folder, renamed on success).
@@ -16,6 +18,7 @@
 #include "FRep/ModelRegistry.h"
 #include "FRep/Sampling.h"
 #include "Lang/ModelFile.h"
+#include "RunCommand.h"
 #include "TetraCommand.h"
 
 #include "Bench.h"
@@ -1112,6 +1115,9 @@ int Run(int argc, char** argv)
   ictk::cli::TetraOptions tetraOptions;
   CLI::App* tetra = ictk::cli::AddTetraCommand(app, tetraOptions);
 
+  ictk::cli::RunModelOptions runOptions;
+  CLI::App* run = ictk::cli::AddRunCommand(app, runOptions);
+
   ictk::cli::ComplexOptions infoOptions;
   CLI::App* info = app.add_subcommand(
     "info", "List the cells, relations and attributes of a complex (.json) or model");
@@ -1166,6 +1172,10 @@ int Run(int argc, char** argv)
   if (*tetra)
   {
     return ictk::cli::RunTetra(tetraOptions);
+  }
+  if (*run)
+  {
+    return ictk::cli::RunModel(runOptions);
   }
   if (*info)
   {

@@ -5,7 +5,7 @@ import sys
 import os
 
 import vtk
-from ictk import ictkFiltersComplex, ictkFiltersFRep
+from ictk import ictkFiltersComplex, ictkFiltersDynamics, ictkFiltersFRep
 
 
 def check(condition, message):
@@ -74,4 +74,17 @@ check(per_dimension == [4, 3, 2, 3], f"flower: cells per dimension {per_dimensio
 for i in range(12):
     leaf = collection.GetPartitionedDataSet(i).GetPartition(0)
     check(leaf.GetPointData().GetArray("colour") is not None, f"flower: colour on cell {i}")
+# A dynamic complex in VTK's temporal pipeline (thesis 5.1): the disk's centre is at x = -2 + t;
+# before the tangency at t = 3 the instance is K1 (2 cells), after it K3 (7 cells).
+dynamic = ictkFiltersDynamics.ictkDynamicComplexSource()
+dynamic.SetFileName(os.environ["ICTK_DISK_RECTANGLE"])
+dynamic.SetTimeStepSize(0.5)
+dynamic.SetFeatureSize(0.1)
+for t, instance, cells in ((2.0, "K1", 2), (4.5, "K3", 7)):
+    dynamic.UpdateTimeStep(t)
+    frame = dynamic.GetOutput()
+    check(dynamic.GetInstanceName() == instance, f"disk at t = {t}: instance {dynamic.GetInstanceName()}")
+    check(frame.GetNumberOfPartitionedDataSets() == cells, f"disk at t = {t}: {cells} cells")
+    stamped = frame.GetInformation().Get(vtk.vtkDataObject.DATA_TIME_STEP())
+    check(abs(stamped - t) < 1e-12, f"DATA_TIME_STEP {stamped}")
 print("python wrapping: all checks passed")

@@ -5,6 +5,7 @@
 Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d | bench
   | bench-scaling
+  run-disk DATA | run-errors DATA   (ictk run on the .icm models in DATA/Models/icm)
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
 "@WORK@" in ICTK-ARGS is replaced by the work folder.
 """
@@ -369,6 +370,16 @@ def check_bench(ictk, work):
     # The plain report names the workload; an --only that matches nothing is a user error.
     if "csg3-64:" not in run(ictk, ["bench", "--quick", "--only", "csg3"]).stdout:
         sys.exit("FAIL: plain report")
+    # The dynamic workload (issue 7): the coherent run and the full re-meshing mesh the same
+    # frames (as many points), the coherent one reusing cells.
+    d = {r["workload"]: r for r in json.loads(run(ictk, ["bench", "--json", "--quick", "--only", "andyhausen"]).stdout)}
+    if sorted(d) != ["andyhausen-10", "andyhausen-10-full"]:
+        sys.exit(f"FAIL: andyhausen workloads: {sorted(d)}")
+    coherent, full = d["andyhausen-10"]["details"], d["andyhausen-10-full"]["details"]
+    if coherent["frames"] != 11 or full["frames"] != 11 or coherent["points"] != full["points"]:
+        sys.exit(f"FAIL: andyhausen frames/points: {coherent} vs {full}")
+    if not (coherent["cells_reused"] > 0 and full["cells_reused"] == 0 and coherent["coherence_speedup"] > 0):
+        sys.exit(f"FAIL: andyhausen coherence counters: {coherent} vs {full}")
     p = run(ictk, ["bench", "--only", "nothing-like-this"], check=False)
     if p.returncode != 2 or "ictk: error: --only" not in p.stderr:
         sys.exit(f"FAIL: --only without a match: exit {p.returncode}\n{p.stderr}")
@@ -497,6 +508,132 @@ def check_tetra_bar(ictk, work, data):
     near(mean, expected, 0.03 * expected, "tip displacement")
 
 
+def read_frame(path):
+    """A .vtpc frame of `ictk run`: {cell name: (leaf, instance)}."""
+    import vtk
+    r = vtk.vtkXMLPartitionedDataSetCollectionReader()
+    r.SetFileName(path)
+    r.Update()
+    pdc = r.GetOutput()
+    cells = {}
+    for i in range(pdc.GetNumberOfPartitionedDataSets()):
+        leaf = pdc.GetPartitionedDataSet(i).GetPartition(0)
+        fd = leaf.GetFieldData()
+        name = fd.GetAbstractArray("CellName").GetValue(0)
+        cells[name] = (leaf, fd.GetAbstractArray("Instance").GetValue(0))
+    return cells
+
+
+def check_run_disk(ictk, work, data):
+    """ictk run on thesis 5.1 (ch5_1_disk_rectangle.icm): the disk's centre is at x = -2 + t and
+    touches the rectangle (left side x = 2) at t = 3: K1 before, K2 at the tangency, K3 after."""
+    import xml.etree.ElementTree as ET
+    model = os.path.join(data, "Models", "icm", "ch5_1_disk_rectangle.icm")
+    pvd = os.path.join(work, "disk.pvd")
+    trace = os.path.join(work, "disk.jsonl")
+    args = ["run", model, "--time", "0:6:0.5", "-o", pvd, "--trace", trace, "--feature-size", "0.1"]
+    summary = json.loads(run(ictk, args + ["--json"]).stdout)
+    if summary["frames"] != 13 or summary["final_instance"] != "K3":
+        sys.exit(f"FAIL: summary {summary}")
+    if [t["to"] for t in summary["transitions"]] != ["K2", "K3"]:
+        sys.exit(f"FAIL: transitions {summary['transitions']}")
+    near(summary["transitions"][0]["time"], 3.0, 1e-6, "time of the tangency")
+    coherence = summary["coherence"]
+    if coherence["moved"] + coherence["reused"] == 0:
+        sys.exit(f"FAIL: nothing reused across frames: {coherence}")
+
+    datasets = ET.parse(pvd).getroot().findall("./Collection/DataSet")
+    if len(datasets) != 13:
+        sys.exit(f"FAIL: {len(datasets)} datasets in the .pvd, not 13")
+    for k, d in enumerate(datasets):
+        near(float(d.get("timestep")), 0.5 * k, 1e-12, f"time of dataset {k}")
+        if not os.path.isfile(os.path.join(work, d.get("file"))):
+            sys.exit(f"FAIL: {d.get('file')} listed but not written")
+    # t = 1 (K1: the rectangle and the disk) and t = 5 (K3: 7 cells), read back by VTK.
+    for k, instance, count in ((2, "K1", 2), (10, "K3", 7)):
+        cells = read_frame(os.path.join(work, datasets[k].get("file")))
+        if len(cells) != count or {i for _, i in cells.values()} != {instance}:
+            sys.exit(f"FAIL: frame {k}: {sorted(cells)} {[i for _, i in cells.values()]}")
+        b = cells["LHKF"][0].GetBounds()
+        t = 0.5 * k
+        near(0.5 * (b[0] + b[1]), -2 + t, 0.01, f"disk centre at t = {t}")
+        near(b[1] - b[0], 2.0, 0.02, f"disk diameter at t = {t}")
+
+    with open(trace) as f:
+        records = [json.loads(line) for line in f if line.strip()]
+    if len(records) != summary["records"] or not all("state" in r and "events" in r for r in records):
+        sys.exit(f"FAIL: trace records {len(records)} vs summary {summary['records']}")
+    # Every frame is an evaluated time (the first one is also the choice of the initial instance).
+    for t in [0.5 * k for k in range(13)]:
+        if not any(abs(r["time"] - t) < 1e-12 for r in records):
+            sys.exit(f"FAIL: no trace record of the frame t = {t}")
+    for r in records:
+        if r["time"] < 3 - 1e-6 and r["instance"] != "K1":
+            sys.exit(f"FAIL: {r} before the tangency")
+        if r["time"] > 3 + 1e-6 and r["instance"] != "K3":
+            sys.exit(f"FAIL: {r} after the tangency")
+    # K2 holds only at the tangency: its records (the located transition, and the frame t = 3
+    # if the engine evaluates it there) are all at t = 3.
+    tangent = [i for i, r in enumerate(records) if r["instance"] == "K2"]
+    if not tangent or not any(records[i]["transition"] for i in tangent):
+        sys.exit(f"FAIL: no transition record to K2: {records}")
+    if any(abs(records[i]["time"] - 3) > 1e-6 for i in tangent) or tangent != list(range(tangent[0], tangent[-1] + 1)):
+        sys.exit(f"FAIL: K2 away from t = 3: {[records[i] for i in tangent]}")
+    if records[tangent[0]]["state"].get("isIntersection") is not True:
+        sys.exit(f"FAIL: K2's state {records[tangent[0]]['state']}")
+    later = [r["instance"] for r in records[tangent[-1] + 1:]]
+    if not later or later[0] != "K3" or set(later) != {"K3"}:
+        sys.exit(f"FAIL: after K2: {later}")
+
+    # A second run replaces the first (frames folder included); without coherence every cell is
+    # meshed in every frame, to the same frames.
+    full = json.loads(run(ictk, args + ["--json", "--no-coherence"]).stdout)
+    c = full["coherence"]
+    if c["moved"] + c["reused"] != 0 or c["computed"] != coherence["computed"] + coherence["moved"] + coherence["reused"]:
+        sys.exit(f"FAIL: --no-coherence {c} vs {coherence}")
+    b_full = read_frame(os.path.join(work, datasets[10].get("file")))["LHKF"][0].GetBounds()
+    near(0.5 * (b_full[0] + b_full[1]), 3.0, 0.01, "disk centre without coherence")
+    if sorted(os.listdir(work)) != ["disk", "disk.jsonl", "disk.pvd"]:
+        sys.exit(f"FAIL: files left in the work folder: {sorted(os.listdir(work))}")
+    text = run(ictk, args).stdout
+    if "13 frames" not in text or "2 transitions" not in text:
+        sys.exit(f"FAIL: summary text:\n{text}")
+
+
+def check_run_errors(ictk, work, data):
+    """ictk run on bad input: exit 2, a clear message, and nothing written or lost."""
+    model = os.path.join(data, "Models", "icm", "ch5_1_disk_rectangle.icm")
+    broken = os.path.join(work, "broken.icm")
+    with open(broken, "w") as f:
+        f.write("name = BROKEN;\nCELLS {\n  A { type = F-CELL; shape = ; }\n}\n")
+    keep = os.path.join(work, "keep.pvd")
+    with open(keep, "w") as f:
+        f.write("the user's file")
+    os.makedirs(os.path.join(work, "keep"))
+    with open(os.path.join(work, "keep", "keep_0000.vtpc"), "w") as f:
+        f.write("an earlier frame")
+    p = run(ictk, ["run", broken, "--time", "0:1:0.5", "-o", keep], check=False)
+    if p.returncode != 2 or not re.match(re.escape(broken) + r":3:\d+: error: ", p.stderr):
+        sys.exit(f"FAIL: malformed model: exit {p.returncode}, stderr:\n{p.stderr}")
+    # T0 before the model's start (its TIMESPAN starts at 0).
+    p = run(ictk, ["run", model, "--time=-1:1:0.5", "-o", keep], check=False)
+    if p.returncode != 2 or "is before the model's start" not in p.stderr:
+        sys.exit(f"FAIL: T0 before the start: exit {p.returncode}, stderr:\n{p.stderr}")
+    # The frames folder holds something else: refused before any work.
+    with open(os.path.join(work, "keep", "notes.txt"), "w") as f:
+        f.write("mine")
+    p = run(ictk, ["run", model, "--time", "0:1:0.5", "-o", keep], check=False)
+    if p.returncode != 2 or "holds other files ('notes.txt')" not in p.stderr:
+        sys.exit(f"FAIL: foreign files: exit {p.returncode}, stderr:\n{p.stderr}")
+    with open(keep) as f:
+        if f.read() != "the user's file":
+            sys.exit("FAIL: the existing .pvd was changed by a failed run")
+    if sorted(os.listdir(os.path.join(work, "keep"))) != ["keep_0000.vtpc", "notes.txt"]:
+        sys.exit(f"FAIL: the frames folder was changed: {os.listdir(os.path.join(work, 'keep'))}")
+    if sorted(os.listdir(work)) != ["broken.icm", "keep", "keep.pvd"]:
+        sys.exit(f"FAIL: files left behind: {sorted(os.listdir(work))}")
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -519,6 +656,10 @@ def main():
     }
     if check == "tetra-bar":
         check_tetra_bar(ictk, work, rest[0])
+        print("OK")
+        return
+    if check in ("run-disk", "run-errors"):
+        (check_run_disk if check == "run-disk" else check_run_errors)(ictk, work, rest[0])
         print("OK")
         return
     if check == "complex-flower":

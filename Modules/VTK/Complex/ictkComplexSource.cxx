@@ -74,6 +74,18 @@ std::shared_ptr<const ictk::complex::Complex> ictkComplexSource::GetComplex(vtkD
   return holder ? holder->Complex : nullptr;
 }
 
+void ictkComplexSource::AttachComplex(
+  vtkDataObject* data, std::shared_ptr<const ictk::complex::Complex> complex)
+{
+  if (!data)
+  {
+    return;
+  }
+  vtkNew<ictkComplexHolder> holder;
+  holder->Complex = std::move(complex);
+  data->GetInformation()->Set(COMPLEX(), holder);
+}
+
 namespace
 {
 using namespace ictk;

@@ -87,6 +87,10 @@ public:
   static ictk::complex::Complex ReadComplexFile(const std::string& path);
   /// The complex a dataset made by this source carries (COMPLEX()), or nullptr.
   static std::shared_ptr<const ictk::complex::Complex> GetComplex(vtkDataObject* data);
+  /// Sets COMPLEX() on a dataset's information, as this source does on its output (for other
+  /// sources of complexes, such as ictkDynamicComplexSource).
+  static void AttachComplex(
+    vtkDataObject* data, std::shared_ptr<const ictk::complex::Complex> complex);
   /// A complex built in C++; used instead of FileName when set.
   void SetComplex(std::shared_ptr<const ictk::complex::Complex> complex);
   /// The VTK form of a discretised complex.

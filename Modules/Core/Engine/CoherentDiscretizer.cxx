@@ -1,0 +1,293 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Engine/CoherentDiscretizer.h"
+
+#include "Complex/Attributes.h"
+#include "FRep/Sampling.h"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace ictk::engine
+{
+namespace
+{
+
+bool sameAffine(const Affine& a, const Affine& b)
+{
+  return a.a == b.a && a.b == b.b;
+}
+
+bool hasWorldParts(const Shape& s)
+{
+  return std::any_of(s.parts.begin(), s.parts.end(),
+    [](const ShapePart& p)
+    { return p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union; });
+}
+
+std::vector<frep::Point3>& pointsOf(complex::CellMesh& m)
+{
+  return m.dimension == 0 ? m.points.points : m.dimension == 1 ? m.curves.points : m.surface.points;
+}
+
+double determinant(const std::array<double, 9>& a)
+{
+  return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+    a[2] * (a[3] * a[7] - a[4] * a[6]);
+}
+
+bool isNormalArray(const discretize::PointArray& array)
+{
+  std::string name = array.name;
+  std::transform(name.begin(), name.end(), name.begin(),
+    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return array.components == 3 && (name == "normals" || name == "normal");
+}
+
+/// The local mesh mapped into the world by `place`.
+complex::CellMesh placed(const complex::CellMesh& local, const Affine& place)
+{
+  complex::CellMesh out = local;
+  if (place.isIdentity())
+  {
+    return out;
+  }
+  for (frep::Point3& p : pointsOf(out))
+  {
+    p = place.apply(p);
+  }
+  // Normals are covectors: they map by the inverse transpose of the linear part.
+  Affine normalMap;
+  bool haveNormalMap = false;
+  for (discretize::PointArray& array : out.pointData())
+  {
+    if (!isNormalArray(array))
+    {
+      continue;
+    }
+    if (!haveNormalMap)
+    {
+      const Affine inverse = place.inverse();
+      for (int r = 0; r < 3; ++r)
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          normalMap.a[3 * r + c] = inverse.a[3 * c + r];
+        }
+      }
+      haveNormalMap = true;
+    }
+    for (std::size_t i = 0; i + 2 < array.values.size(); i += 3)
+    {
+      Vec3 n = normalMap.applyLinear({ array.values[i], array.values[i + 1], array.values[i + 2] });
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (int k = 0; k < 3; ++k)
+      {
+        array.values[i + k] = length > 0 ? n[k] / length : n[k];
+      }
+    }
+  }
+  // A mirroring placement turns triangles inside out; keep the outward orientation.
+  if (out.dimension >= 2 && determinant(place.a) < 0)
+  {
+    for (auto& t : out.surface.triangles)
+    {
+      std::swap(t[1], t[2]);
+    }
+  }
+  return out;
+}
+
+} // namespace
+
+CoherenceStats& CoherenceStats::operator+=(const CoherenceStats& o)
+{
+  frames += o.frames;
+  computed += o.computed;
+  moved += o.moved;
+  reused += o.reused;
+  seconds += o.seconds;
+  return *this;
+}
+
+CoherentDiscretizer::CoherentDiscretizer(CoherenceOptions options)
+  : options_(std::move(options))
+  , featureSize_(options_.featureSize > 0 ? options_.featureSize : 0.0)
+{
+}
+
+double CoherentDiscretizer::defaultFeatureSize(const complex::Complex& complex)
+{
+  const frep::Box3 b = complex::complexBounds(complex);
+  double side = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    side = std::max(side, b.hi[a] - b.lo[a]);
+  }
+  return side > 0 && std::isfinite(side) ? side / 64 : 1.0 / 64;
+}
+
+void CoherentDiscretizer::reset()
+{
+  kept_.clear();
+  last_ = {};
+  total_ = {};
+  lastCells_.clear();
+}
+
+complex::ComplexMesh CoherentDiscretizer::discretize(const DynamicModel& model)
+{
+  return discretize(model.cells(), model.complex());
+}
+
+complex::ComplexMesh CoherentDiscretizer::discretize(
+  const std::vector<CellState>& cells, const complex::Complex& complex)
+{
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<complex::CellId> ids = complex.cellIds();
+  if (ids.size() != cells.size())
+  {
+    throw std::invalid_argument("the complex has " + std::to_string(ids.size()) +
+      " cells but the model reports " + std::to_string(cells.size()));
+  }
+  if (!(featureSize_ > 0))
+  {
+    featureSize_ = defaultFeatureSize(complex);
+  }
+  complex::DiscretizationOptions o;
+  o.featureSize = featureSize_;
+  o.tolerance = options_.tolerance;
+  o.threads = options_.threads;
+
+  CoherenceStats frame;
+  frame.frames = 1;
+  std::vector<std::pair<std::string, CellWork>> work;
+  work.reserve(ids.size());
+  complex::ComplexMesh mesh;
+  mesh.featureSize = featureSize_;
+  mesh.cells.reserve(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i)
+  {
+    const complex::CellId id = ids[i];
+    if (id >= cells.size() || complex.cell(id).name != cells[id].name)
+    {
+      throw std::invalid_argument("cell " + std::to_string(id) + " of the complex ('" +
+        complex.cell(id).name + "') is not the model's cell of that index");
+    }
+    const CellState& state = cells[id];
+    if (!state.shape)
+    {
+      throw std::invalid_argument("cell '" + state.name + "' has no shape");
+    }
+    const Shape& shape = *state.shape;
+    const bool worldParts = hasWorldParts(shape);
+    // World-space parts ignore the placement of a local frame: such a shape is meshed where it
+    // is, and its mesh holds for that placement only.
+    const Affine place = worldParts ? Affine{} : shape.place;
+
+    auto found = kept_.find(state.name);
+    const bool valid = options_.coherent && found != kept_.end() &&
+      found->second.version == state.shapeVersion && found->second.worldParts == worldParts &&
+      (!worldParts || sameAffine(found->second.madeUnder, shape.place));
+    if (valid)
+    {
+      Kept& kept = found->second;
+      if (sameAffine(kept.lastPlace, shape.place))
+      {
+        ++frame.reused;
+        work.emplace_back(state.name, CellWork::Reused);
+      }
+      else
+      {
+        ++frame.moved;
+        work.emplace_back(state.name, CellWork::Moved);
+      }
+      kept.lastPlace = shape.place;
+      mesh.cells.push_back(placed(kept.local, place));
+    }
+    else
+    {
+      Shape local = shape;
+      if (!worldParts)
+      {
+        local.place = Affine{};
+      }
+      complex::Complex one;
+      one.name = state.name;
+      complex::Cell cell = toComplexCell(local, state.kind, options_.geometry);
+      cell.attributes.clear();
+      cell.operands.clear();
+      const complex::CellId localId = one.addCell(std::move(cell));
+      complex::DiscretizationOptions cellOptions = o;
+      cellOptions.progress = nullptr;
+      Kept kept;
+      kept.version = state.shapeVersion;
+      kept.local = complex::discretizeCell(one, localId, cellOptions);
+      kept.local.pointData().clear();
+      kept.worldParts = worldParts;
+      kept.madeUnder = shape.place;
+      kept.lastPlace = shape.place;
+      mesh.cells.push_back(placed(kept.local, place));
+      ++frame.computed;
+      work.emplace_back(state.name, CellWork::Computed);
+      if (options_.coherent)
+      {
+        kept_[state.name] = std::move(kept);
+      }
+    }
+    mesh.cells.back().cell = id;
+    if (options_.progress && !options_.progress(0.9 * double(i + 1) / double(ids.size())))
+    {
+      throw frep::Cancelled();
+    }
+  }
+
+  // Attributes are functions of world position: evaluated where the points are now, never kept.
+  for (complex::CellMesh& m : mesh.cells)
+  {
+    for (const auto& binding : complex.cell(m.cell).attributes)
+    {
+      complex::appendAttribute(binding, m.vertices(), m.pointData());
+    }
+  }
+  if (!complex.attributes().empty())
+  {
+    complex::AttributeLookup lookup(complex, mesh, 0.25 * featureSize_);
+    for (complex::CellMesh& m : mesh.cells)
+    {
+      const complex::Cell& c = complex.cell(m.cell);
+      for (const auto& [name, defaults] : complex.attributes())
+      {
+        const bool bound = std::any_of(c.attributes.begin(), c.attributes.end(),
+          [&](const complex::AttributeBinding& b) { return b.attribute == name; });
+        if (bound)
+        {
+          continue;
+        }
+        discretize::PointArray array;
+        array.name = name;
+        array.components = defaults.components;
+        for (const frep::Point3& p : m.vertices())
+        {
+          const auto v = lookup.value(name, p).value;
+          array.values.insert(array.values.end(), v.begin(), v.end());
+        }
+        m.pointData().push_back(std::move(array));
+      }
+    }
+  }
+  if (options_.progress && !options_.progress(1.0))
+  {
+    throw frep::Cancelled();
+  }
+  frame.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  last_ = frame;
+  total_ += frame;
+  lastCells_ = std::move(work);
+  return mesh;
+}
+
+} // namespace ictk::engine
