@@ -459,3 +459,15 @@ TEST(EngineComplex, AttributesFollowTheirCell)
       EXPECT_TRUE(c.cell(static_cast<ictk::complex::CellId>(i)).attributes.empty());
     }
 }
+
+// Frames requested at i x 0.1 (0.30000000000000004, 0.6000000000000001, ...) with steps of 0.1
+// give one record each: no extra frame for a rounding remainder.
+TEST(EngineExemplars, OneRecordPerRequestedFrame)
+{
+  DynamicModel m = load("ch5_1_disk_rectangle.icm");
+  std::size_t records = 0;
+  for (int i = 1; i <= 20; ++i)
+    for (const FrameRecord& r : m.advanceTo(i * 0.1, 0.1))
+      records += r.transition ? 0 : 1;
+  EXPECT_EQ(records, 20u);
+}

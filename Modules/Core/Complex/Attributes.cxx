@@ -1,36 +1,60 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Complex/Attributes.h"
 
+#include <algorithm>
+
 namespace ictk::complex
 {
 
 AttributeLookup::AttributeLookup(const Complex& complex, const ComplexMesh& mesh, double tolerance)
   : complex_(complex)
+  , mesh_(mesh)
   , tolerance_(tolerance)
 {
   for (CellId id : complex.cellIds())
   {
-    locators_.emplace(id, CellLocator(complex.cell(id), mesh.of(id)));
+    Box3 b = complex.cell(id).bounds();
+    for (int a = 0; a < 3; ++a)
+    {
+      b.lo[a] -= tolerance;
+      b.hi[a] += tolerance;
+    }
+    boxes_.emplace(id, b);
   }
 }
 
-AttributeLookup::Result AttributeLookup::value(const std::string& attribute, const Point3& p)
+bool AttributeLookup::holds(CellId id, const Point3& p)
+{
+  const Box3& b = boxes_.at(id);
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!(p[a] >= b.lo[a] && p[a] <= b.hi[a]))
+    {
+      return false;
+    }
+  }
+  auto it = locators_.find(id);
+  if (it == locators_.end())
+  {
+    it = locators_.emplace(id, CellLocator(complex_.cell(id), mesh_.of(id))).first;
+  }
+  return it->second.distance(p) <= tolerance_;
+}
+
+AttributeLookup::Result AttributeLookup::value(
+  const std::string& attribute, const Point3& p, std::optional<CellId> on)
 {
   auto declared = complex_.attributes().find(attribute);
   if (declared == complex_.attributes().end())
   {
     throw ComplexError("the complex has no attribute '" + attribute + "'");
   }
+  // Only cells that bind the attribute can give its value; the others matter only for the
+  // choice of default (inside some cell or outside all), asked when nothing binds.
   const AttributeBinding* best = nullptr;
   const Cell* bestCell = nullptr;
-  bool inSomeCell = false;
-  for (auto& [id, locator] : locators_)
+  for (CellId id : complex_.cellIds())
   {
-    if (!(locator.distance(p) <= tolerance_))
-    {
-      continue;
-    }
-    inSomeCell = true;
     const Cell& c = complex_.cell(id);
     for (const auto& b : c.attributes)
     {
@@ -40,7 +64,7 @@ AttributeLookup::Result AttributeLookup::value(const std::string& attribute, con
       }
       const bool better = !best || b.priority > best->priority ||
         (b.priority == best->priority && c.dimension < bestCell->dimension);
-      if (better)
+      if (better && holds(id, p))
       {
         best = &b;
         bestCell = &c;
@@ -55,12 +79,50 @@ AttributeLookup::Result AttributeLookup::value(const std::string& attribute, con
     {
       r.value.push_back(component->evaluator()->value(p));
     }
+    return r;
   }
-  else
+  bool inSomeCell = on.has_value();
+  for (CellId id : complex_.cellIds())
   {
-    r.value = inSomeCell ? declared->second.inside : declared->second.outside;
+    if (inSomeCell)
+    {
+      break;
+    }
+    inSomeCell = holds(id, p);
   }
+  r.value = inSomeCell ? declared->second.inside : declared->second.outside;
   return r;
+}
+
+void appendUnboundAttributes(const Complex& complex, ComplexMesh& mesh, double tolerance)
+{
+  if (complex.attributes().empty())
+  {
+    return;
+  }
+  AttributeLookup lookup(complex, mesh, tolerance);
+  for (CellMesh& m : mesh.cells)
+  {
+    const Cell& c = complex.cell(m.cell);
+    for (const auto& [name, defaults] : complex.attributes())
+    {
+      const bool bound = std::any_of(c.attributes.begin(), c.attributes.end(),
+        [&](const AttributeBinding& b) { return b.attribute == name; });
+      if (bound)
+      {
+        continue;
+      }
+      discretize::PointArray array;
+      array.name = name;
+      array.components = defaults.components;
+      for (const Point3& p : m.vertices())
+      {
+        const auto v = lookup.value(name, p, m.cell).value;
+        array.values.insert(array.values.end(), v.begin(), v.end());
+      }
+      m.pointData().push_back(std::move(array));
+    }
+  }
 }
 
 void appendAttribute(const AttributeBinding& binding, const std::vector<Point3>& points,

@@ -27,14 +27,25 @@ public:
     /// The cell whose binding gave the value; empty for a default.
     std::optional<CellId> cell;
   };
-  /// Throws ComplexError for an attribute the complex does not declare.
-  Result value(const std::string& attribute, const Point3& p);
+  /// Throws ComplexError for an attribute the complex does not declare. `on`: a cell the point
+  /// is known to lie on (a vertex of its discretisation), which spares locating it when no
+  /// binding applies (the inside default then holds).
+  Result value(const std::string& attribute, const Point3& p, std::optional<CellId> on = {});
 
 private:
+  bool holds(CellId id, const Point3& p);
+
   const Complex& complex_;
+  const ComplexMesh& mesh_;
   double tolerance_;
-  std::map<CellId, CellLocator> locators_;
+  std::map<CellId, CellLocator> locators_; ///< built when a point first falls in the cell's box
+  std::map<CellId, Box3> boxes_; ///< cell bounds grown by the tolerance: a cheap first test
 };
+
+/// Gives every cell's discretisation the declared attributes the cell does not bind, resolved
+/// at its vertices by the bindings of the cells that hold them (priority) or the defaults, so
+/// that every output point carries every attribute.
+void appendUnboundAttributes(const Complex& complex, ComplexMesh& mesh, double tolerance);
 
 /// Evaluates the attribute function at the given points, appending a point array named after
 /// the attribute. Values that are not finite are kept (NaN marks "undefined here").

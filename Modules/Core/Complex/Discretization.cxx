@@ -327,34 +327,7 @@ ComplexMesh discretizeComplex(const Complex& complex, const DiscretizationOption
       throw frep::Cancelled();
     }
   }
-  // Declared attributes a cell does not bind are resolved by priority among the cells that hold
-  // each point, or take their defaults, so that every output point carries every attribute.
-  if (!complex.attributes().empty())
-  {
-    AttributeLookup lookup(complex, mesh, 0.25 * o.featureSize);
-    for (CellMesh& m : mesh.cells)
-    {
-      const Cell& c = complex.cell(m.cell);
-      for (const auto& [name, defaults] : complex.attributes())
-      {
-        const bool bound = std::any_of(c.attributes.begin(), c.attributes.end(),
-          [&](const AttributeBinding& b) { return b.attribute == name; });
-        if (bound)
-        {
-          continue;
-        }
-        discretize::PointArray array;
-        array.name = name;
-        array.components = defaults.components;
-        for (const Point3& p : m.vertices())
-        {
-          const auto v = lookup.value(name, p).value;
-          array.values.insert(array.values.end(), v.begin(), v.end());
-        }
-        m.pointData().push_back(std::move(array));
-      }
-    }
-  }
+  appendUnboundAttributes(complex, mesh, 0.25 * o.featureSize);
   if (o.progress && !o.progress(1.0))
   {
     throw frep::Cancelled();

@@ -253,32 +253,7 @@ complex::ComplexMesh CoherentDiscretizer::discretize(
       complex::appendAttribute(binding, m.vertices(), m.pointData());
     }
   }
-  if (!complex.attributes().empty())
-  {
-    complex::AttributeLookup lookup(complex, mesh, 0.25 * featureSize_);
-    for (complex::CellMesh& m : mesh.cells)
-    {
-      const complex::Cell& c = complex.cell(m.cell);
-      for (const auto& [name, defaults] : complex.attributes())
-      {
-        const bool bound = std::any_of(c.attributes.begin(), c.attributes.end(),
-          [&](const complex::AttributeBinding& b) { return b.attribute == name; });
-        if (bound)
-        {
-          continue;
-        }
-        discretize::PointArray array;
-        array.name = name;
-        array.components = defaults.components;
-        for (const frep::Point3& p : m.vertices())
-        {
-          const auto v = lookup.value(name, p).value;
-          array.values.insert(array.values.end(), v.begin(), v.end());
-        }
-        m.pointData().push_back(std::move(array));
-      }
-    }
-  }
+  complex::appendUnboundAttributes(complex, mesh, 0.25 * featureSize_);
   if (options_.progress && !options_.progress(1.0))
   {
     throw frep::Cancelled();

@@ -1975,7 +1975,9 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
   while (time() < t)
   {
     const double now = time();
-    const double target = (maxStep >= t - now) ? t : now + maxStep;
+    // A remainder below 1e-9 of the step (6 x 0.1 is 0.6000000000000001) joins this step
+    // instead of becoming a frame of its own.
+    const double target = (now + maxStep >= t - 1e-9 * maxStep) ? t : now + maxStep;
     const dyn::Stepper::Snapshot snap = m.stepper->save();
     m.step(target - now);
     auto valid = m.validInstances(target);
