@@ -45,6 +45,7 @@
 //   extrapolation (relative error ~1e-6 in 2D, ~1e-4 in 3D).
 #include "Engine/Shapes.h"
 
+#include "Dynamics/RootFinding.h"
 #include "FRep/Expr.h"
 #include "FRep/Tape.h"
 
@@ -1332,52 +1333,12 @@ void curveRoots(const At& at, double lo, double hi, int n, const F& f, const G& 
   {
     sm.near = nearZero(sm.t, sm.v);
   }
+  // Illinois on the sign change (the same refinement the stepper uses), to the last bits of t.
   auto illinois = [&](double a, double fa, double b, double fb)
   {
-    int side = 0;
-    for (int it = 0; it < 200; ++it)
-    {
-      double c = (a * fb - b * fa) / (fb - fa);
-      if (!(c > std::min(a, b) && c < std::max(a, b)))
-      {
-        // The secant fell on an end by rounding: bisect instead.
-        c = 0.5 * (a + b);
-        if (!(c > std::min(a, b) && c < std::max(a, b)))
-        {
-          return c;
-        }
-      }
-      const double fc = valueAt(c);
-      if (fc == 0 || std::abs(b - a) <= 1e-16 * (std::abs(a) + std::abs(b)))
-      {
-        return c;
-      }
-      if ((fc > 0) == (fb > 0))
-      {
-        b = c;
-        fb = fc;
-        if (side == -1)
-        {
-          fa *= 0.5;
-        }
-        side = -1;
-      }
-      else
-      {
-        a = c;
-        fa = fc;
-        if (side == 1)
-        {
-          fb *= 0.5;
-        }
-        side = 1;
-      }
-      if (std::abs(b - a) <= 4e-16 * std::max(1.0, std::abs(a)))
-      {
-        break;
-      }
-    }
-    return std::abs(fa) < std::abs(fb) ? a : b;
+    dyn::LocateOptions o;
+    o.timeTolerance = 4e-16 * std::max(1.0, std::abs(a));
+    return dyn::refineRoot(valueAt, a, fa, b, fb, o);
   };
   // Consecutive samples within tolerance of the other curve are one meeting point: near a
   // tangency g stays within tolerance over a stretch of width ~sqrt(tolerance x radius).
