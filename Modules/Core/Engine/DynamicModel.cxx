@@ -244,7 +244,7 @@ struct DynamicModel::Impl
   std::vector<std::string> cellsOf(const Instance& in, int depth) const;
   std::vector<RelationSpec> relationsOf(
     const Instance& in, const std::string& kind, int depth) const;
-  RelationSpec relationSpec(const Relation& r, bool dependency) const;
+  RelationSpec relationSpec(const Relation& r) const;
   void buildAttributes(const lang::icm::AttributesSection& section);
   std::vector<std::pair<std::string, std::string>> attributeLinksOf(
     const Instance& in, int depth) const;
@@ -771,7 +771,7 @@ void DynamicModel::Impl::buildShape(CellSpec& c, const Property& p)
   }
 }
 
-RelationSpec DynamicModel::Impl::relationSpec(const Relation& r, bool dependency) const
+RelationSpec DynamicModel::Impl::relationSpec(const Relation& r) const
 {
   RelationSpec s;
   s.pos = r.pos;
@@ -796,7 +796,6 @@ RelationSpec DynamicModel::Impl::relationSpec(const Relation& r, bool dependency
     fail(r.pos, "a relation has two ends");
   split(*r.ends[0], s.master, s.masterMember);
   split(*r.ends[1], s.dependent, s.dependentMember);
-  (void)dependency;
   return s;
 }
 
@@ -880,7 +879,7 @@ std::vector<RelationSpec> DynamicModel::Impl::relationsOf(
       : kind == "boundary"                  ? section.boundary
                                             : section.containment;
     for (const Relation& r : list)
-      out.push_back(relationSpec(r, kind == "dependency"));
+      out.push_back(relationSpec(r));
   }
   return out;
 }
@@ -1387,8 +1386,8 @@ const Procedure* DynamicModel::Impl::procedureFor(
 namespace
 {
 
-std::vector<Value> timeArgs(const Procedure& p, double globalT, double localT, double lifeT,
-  double dt, const dyn::Event* ev, const std::map<std::string, std::vector<std::string>>& names)
+std::vector<Value> timeArgs(
+  const Procedure& p, double globalT, double localT, double lifeT, double dt, const dyn::Event* ev)
 {
   std::vector<Value> args;
   std::size_t k = 0;
@@ -1398,7 +1397,6 @@ std::vector<Value> timeArgs(const Procedure& p, double globalT, double localT, d
     e.type = Value::Type::Event;
     e.text = ev->name;
     e.fields = ev->parameters;
-    (void)names;
     args.push_back(e);
     k = 1;
   }
@@ -1443,7 +1441,7 @@ void DynamicModel::Impl::runCell(
   }
   EngineScope scope(*this, cell, s.active);
   context = &c;
-  interpreter.run(*p, timeArgs(*p, c.globalT, localT, lifeT, c.dt, ev, eventParams), scope);
+  interpreter.run(*p, timeArgs(*p, c.globalT, localT, lifeT, c.dt, ev), scope);
   context = nullptr;
 }
 
@@ -1456,8 +1454,7 @@ void DynamicModel::Impl::runInstance(
   const double local = c.globalT - s.activatedAt;
   EngineScope scope(*this, {}, i);
   context = &c;
-  interpreter.run(
-    *it->second, timeArgs(*it->second, c.globalT, local, local, c.dt, ev, eventParams), scope);
+  interpreter.run(*it->second, timeArgs(*it->second, c.globalT, local, local, c.dt, ev), scope);
   context = nullptr;
 }
 
@@ -1501,8 +1498,8 @@ std::vector<std::size_t> DynamicModel::Impl::validInstances(double t)
     // An instance that is not active has not started: its local time is 0.
     const double local = s.active == i ? t - s.activatedAt : 0.0;
     EngineScope scope(*this, {}, i);
-    const Value r = interpreter.run(
-      *in.predicate, timeArgs(*in.predicate, t, local, local, 0.0, nullptr, eventParams), scope);
+    const Value r =
+      interpreter.run(*in.predicate, timeArgs(*in.predicate, t, local, local, 0.0, nullptr), scope);
     if (r.type != Value::Type::Bool)
       fail(in.predicate->pos,
         "the predicate of " + in.name + " returned a " + typeName(r.type) + ", not a bool");

@@ -174,7 +174,6 @@ struct Interpreter::Frame
   std::map<std::string, Value> locals;
   long long iterations = 0;
   int depth = 0; ///< model-function calls (bounded: functions call only earlier ones)
-  bool returned = false;
   Value result;
 };
 
@@ -191,7 +190,7 @@ void Interpreter::fail(Pos pos, const std::string& message) const
 
 Value Interpreter::run(const Procedure& p, const std::vector<Value>& args, Scope& scope) const
 {
-  Frame f{ scope, {}, 0, 0, false, {} };
+  Frame f{ scope, {}, 0, 0, {} };
   for (std::size_t i = 0; i < p.formals.size(); ++i)
     f.locals[p.formals[i].name] = i < args.size() ? args[i] : Value{};
   exec(p.body, f);
@@ -200,7 +199,7 @@ Value Interpreter::run(const Procedure& p, const std::vector<Value>& args, Scope
 
 Value Interpreter::evaluate(const Expr& e, Scope& scope) const
 {
-  Frame f{ scope, {}, 0, 0, false, {} };
+  Frame f{ scope, {}, 0, 0, {} };
   return eval(e, f);
 }
 
@@ -567,7 +566,7 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
         // number of functions; the guard protects models built without the checker.
         if (f.depth > static_cast<int>(functions_->size()))
           fail(call.pos, "function calls nest deeper than the number of functions (recursion?)");
-        Frame inner{ f.scope, {}, f.iterations, f.depth + 1, false, {} };
+        Frame inner{ f.scope, {}, f.iterations, f.depth + 1, {} };
         for (std::size_t i = 0; i < p.formals.size(); ++i)
           inner.locals[p.formals[i].name] = args[i];
         exec(p.body, inner);
@@ -661,7 +660,6 @@ bool Interpreter::exec(const Stmt& s, Frame& f) const
     }
     case Stmt::Kind::Return:
       f.result = s.value ? eval(*s.value, f) : Value{};
-      f.returned = true;
       return true;
     case Stmt::Kind::Placeholder:
       fail(s.pos, "'...' is a placeholder of the thesis' notation, not a statement");
