@@ -464,10 +464,6 @@ struct ResolvedModel
   std::array<double, 3> Hi;
 };
 
-/// The box searched for a file model's bounds when the file gives none (HyperFun's default
-/// modelling box is [-10, 10]^3).
-constexpr double FileSearchHalfWidth = 10.0;
-
 /// Opens a model file, turning its diagnostics into the user error (they name file, line and
 /// column already).
 lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>& params = {})
@@ -502,41 +498,8 @@ ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<doub
     return { info.name, info.build(), info.boundsLo, info.boundsHi };
   }
   lang::ModelFile file = OpenModelFile(nameOrPath, params);
-  ResolvedModel model{ file.name, std::move(file.model), {}, {} };
-  if (file.bounds)
-  {
-    const auto& b = *file.bounds;
-    model.Lo = { b[0], b[2], b[4] };
-    model.Hi = { b[1], b[3], b[5] };
-    return model;
-  }
-  // No bounds in the file: find them by interval arithmetic, the domain's missing axes flat.
-  const frep::Box search{ { -FileSearchHalfWidth, -FileSearchHalfWidth, -FileSearchHalfWidth },
-    { FileSearchHalfWidth, FileSearchHalfWidth, FileSearchHalfWidth } };
-  std::vector<double> boundParams = params;
-  boundParams.resize(
-    std::max(boundParams.size(), static_cast<std::size_t>(file.parameterCount)), 0.0);
-  std::optional<frep::Box> box;
-  try
-  {
-    box = frep::boundingBox(
-      frep::Tape::compile(model.Model.geometry().function()), search, 6, 0.0, boundParams);
-  }
-  catch (const std::invalid_argument&)
-  {
-    box = search; // a model whose parameters are needed to bound it: sample the whole box
-  }
-  const frep::Box b = box ? *box : search;
-  const std::uint8_t axes = frep::domainAxes(model.Model.geometry().domain());
-  for (int a = 0; a < 3; ++a)
-  {
-    const bool used = axes & (1u << a);
-    // A little margin, so the surface does not touch the grid's border.
-    const double pad = 0.02 * (b.hi[a] - b.lo[a]);
-    model.Lo[a] = used ? b.lo[a] - pad : 0.0;
-    model.Hi[a] = used ? b.hi[a] + pad : 0.0;
-  }
-  return model;
+  const std::array<double, 6> b = lang::modelFileBounds(file, params);
+  return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] } };
 }
 
 struct EvalOptions

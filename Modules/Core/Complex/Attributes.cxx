@@ -2,6 +2,7 @@
 #include "Complex/Attributes.h"
 
 #include <algorithm>
+#include <set>
 
 namespace ictk::complex
 {
@@ -94,15 +95,73 @@ AttributeLookup::Result AttributeLookup::value(
   return r;
 }
 
-void appendUnboundAttributes(const Complex& complex, ComplexMesh& mesh, double tolerance)
+namespace
+{
+bool binds(const Cell& c, const std::string& attribute)
+{
+  return std::any_of(c.attributes.begin(), c.attributes.end(),
+    [&](const AttributeBinding& b) { return b.attribute == attribute; });
+}
+
+bool near(const Box3& a, const Box3& b, double tolerance)
+{
+  for (int k = 0; k < 3; ++k)
+  {
+    if (a.lo[k] > b.hi[k] + tolerance || b.lo[k] > a.hi[k] + tolerance)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+} // namespace
+
+std::vector<CellId> attributeSupport(
+  const Complex& complex, const std::vector<CellId>& targets, double tolerance)
+{
+  std::vector<CellId> support;
+  const std::set<CellId> targetSet(targets.begin(), targets.end());
+  for (CellId id : complex.cellIds())
+  {
+    if (targetSet.count(id))
+    {
+      continue;
+    }
+    const Cell& c = complex.cell(id);
+    const Box3 box = c.bounds();
+    const bool needed = std::any_of(c.attributes.begin(), c.attributes.end(),
+      [&](const AttributeBinding& b)
+      {
+        return std::any_of(targets.begin(), targets.end(),
+          [&](CellId t)
+          {
+            const Cell& target = complex.cell(t);
+            return !binds(target, b.attribute) && near(box, target.bounds(), tolerance);
+          });
+      });
+    if (needed)
+    {
+      support.push_back(id);
+    }
+  }
+  return support;
+}
+
+void appendUnboundAttributes(
+  const Complex& complex, ComplexMesh& mesh, double tolerance, const std::vector<CellId>& targets)
 {
   if (complex.attributes().empty())
   {
     return;
   }
+  const std::set<CellId> targetSet(targets.begin(), targets.end());
   AttributeLookup lookup(complex, mesh, tolerance);
   for (CellMesh& m : mesh.cells)
   {
+    if (!targetSet.empty() && !targetSet.count(m.cell))
+    {
+      continue;
+    }
     const Cell& c = complex.cell(m.cell);
     for (const auto& [name, defaults] : complex.attributes())
     {

@@ -45,7 +45,15 @@ private:
 /// Gives every cell's discretisation the declared attributes the cell does not bind, resolved
 /// at its vertices by the bindings of the cells that hold them (priority) or the defaults, so
 /// that every output point carries every attribute.
-void appendUnboundAttributes(const Complex& complex, ComplexMesh& mesh, double tolerance);
+/// `targets`: only these cells' discretisations get the arrays (empty: all); the other cells of
+/// `mesh` only serve to locate points.
+void appendUnboundAttributes(const Complex& complex, ComplexMesh& mesh, double tolerance,
+  const std::vector<CellId>& targets = {});
+/// The cells whose discretisations appendUnboundAttributes may consult for the vertices of
+/// `targets`, besides the targets themselves: cells that bind an attribute some target does not
+/// bind, with bounds within `tolerance` of that target's.
+std::vector<CellId> attributeSupport(
+  const Complex& complex, const std::vector<CellId>& targets, double tolerance);
 
 /// Evaluates the attribute function at the given points, appending a point array named after
 /// the attribute. Values that are not finite are kept (NaN marks "undefined here").

@@ -240,6 +240,8 @@ void discretizeMapped(
   }
 }
 
+} // namespace
+
 double defaultFeatureSize(const Complex& complex)
 {
   const Box3 b = complexBounds(complex);
@@ -250,8 +252,6 @@ double defaultFeatureSize(const Complex& complex)
   }
   return side > 0 && std::isfinite(side) ? side / 64 : 1.0 / 64;
 }
-
-} // namespace
 
 CellMesh discretizeCell(const Complex& complex, CellId id, const DiscretizationOptions& options)
 {
@@ -316,7 +316,26 @@ ComplexMesh discretizeComplex(const Complex& complex, const DiscretizationOption
     o.featureSize = defaultFeatureSize(complex);
   }
   mesh.featureSize = o.featureSize;
-  const std::vector<CellId> ids = complex.cellIds();
+  const double attributeTolerance = 0.25 * o.featureSize;
+  std::vector<CellId> ids = complex.cellIds();
+  std::vector<CellId> targets;
+  if (!o.cells.empty())
+  {
+    // A part of the complex: its cells, and the cells its unbound attributes are looked up in.
+    targets = o.cells;
+    std::sort(targets.begin(), targets.end());
+    targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+    for (CellId id : targets)
+    {
+      complex.cell(id); // throws ComplexError naming an unknown id
+    }
+    ids = targets;
+    for (CellId id : attributeSupport(complex, targets, attributeTolerance))
+    {
+      ids.push_back(id);
+    }
+    std::sort(ids.begin(), ids.end());
+  }
   std::size_t done = 0;
   for (CellId id : ids)
   {
@@ -327,7 +346,14 @@ ComplexMesh discretizeComplex(const Complex& complex, const DiscretizationOption
       throw frep::Cancelled();
     }
   }
-  appendUnboundAttributes(complex, mesh, 0.25 * o.featureSize);
+  appendUnboundAttributes(complex, mesh, attributeTolerance, targets);
+  if (!targets.empty())
+  {
+    mesh.cells.erase(std::remove_if(mesh.cells.begin(), mesh.cells.end(),
+                       [&](const CellMesh& m)
+                       { return !std::binary_search(targets.begin(), targets.end(), m.cell); }),
+      mesh.cells.end());
+  }
   if (o.progress && !o.progress(1.0))
   {
     throw frep::Cancelled();

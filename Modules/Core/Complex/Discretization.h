@@ -24,6 +24,9 @@ struct DiscretizationOptions
   int threads = 0;
   /// Called with the completed fraction; return false to cancel (throws frep::Cancelled).
   std::function<bool(double)> progress;
+  /// discretizeComplex: only these cells (a selection, or one MPI rank's share); empty = every
+  /// cell. Their meshes equal those of a whole discretisation, attributes included.
+  std::vector<CellId> cells;
 };
 
 /// The discretisation of one cell. Exactly one of the members is filled, by dimension: points
@@ -50,6 +53,9 @@ struct ComplexMesh
 /// The box that holds every cell (explicit cells by their points, implicit by their bounds,
 /// mapped cells by a coarse sample of their map).
 Box3 complexBounds(const Complex& complex);
+
+/// The default feature size: 1/64 of the largest side of complexBounds.
+double defaultFeatureSize(const Complex& complex);
 
 CellMesh discretizeCell(
   const Complex& complex, CellId id, const DiscretizationOptions& options = {});

@@ -181,12 +181,13 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
     if (options.prune && tape->choiceCount() > 0)
     {
       Region region;
-      region.axes[0] = { grid.origin[0] + i0 * grid.spacing[0],
-        grid.origin[0] + (i1 - 1) * grid.spacing[0] };
-      region.axes[1] = { grid.origin[1] + j0 * grid.spacing[1],
-        grid.origin[1] + (j1 - 1) * grid.spacing[1] };
-      region.axes[2] = { grid.origin[2] + k0 * grid.spacing[2],
-        grid.origin[2] + (k1 - 1) * grid.spacing[2] };
+      const auto& g = grid.first;
+      region.axes[0] = { grid.origin[0] + (g[0] + i0) * grid.spacing[0],
+        grid.origin[0] + (g[0] + i1 - 1) * grid.spacing[0] };
+      region.axes[1] = { grid.origin[1] + (g[1] + j0) * grid.spacing[1],
+        grid.origin[1] + (g[1] + j1 - 1) * grid.spacing[1] };
+      region.axes[2] = { grid.origin[2] + (g[2] + k0) * grid.spacing[2],
+        grid.origin[2] + (g[2] + k1 - 1) * grid.spacing[2] };
       region.axes[3] = { grid.time, grid.time };
       ws.interval.eval(region);
       evaluator = &ws.evaluatorFor(ws.interval.choices());
@@ -200,11 +201,12 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
     }
     for (std::int64_t k = k0; k < k1; ++k)
     {
-      const double z = grid.origin[2] + k * grid.spacing[2];
+      const double z = grid.origin[2] + (grid.first[2] + k) * grid.spacing[2];
       for (std::int64_t j = j0; j < j1; ++j)
       {
-        const double y = grid.origin[1] + j * grid.spacing[1];
-        writeRow(*evaluator, (k * dims[1] + j) * dims[0] + i0, i0,
+        const double y = grid.origin[1] + (grid.first[1] + j) * grid.spacing[1];
+        // The row's index along x in the whole grid, from which evalRowX computes x.
+        writeRow(*evaluator, (k * dims[1] + j) * dims[0] + i0, grid.first[0] + i0,
           static_cast<std::size_t>(i1 - i0), y, z);
       }
     }

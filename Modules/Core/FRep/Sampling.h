@@ -23,6 +23,10 @@ struct Grid
   std::array<double, 3> spacing{ 1, 1, 1 };
   std::array<std::int64_t, 3> dimensions{ 0, 0, 0 };
   double time = 0;
+  /// Where this grid starts in a larger one it is a piece of (an update extent, an MPI rank's
+  /// slab): point (i, j, k) is at origin + (first + (i, j, k)) * spacing, computed exactly as the
+  /// whole grid computes it, so pieces of a double-precision sampling equal the whole bit for bit.
+  std::array<std::int64_t, 3> first{ 0, 0, 0 };
   std::int64_t pointCount() const { return dimensions[0] * dimensions[1] * dimensions[2]; }
 };
 

@@ -7,6 +7,9 @@
 #include "Lang/HyperFun.h"
 #include "Lang/VmReader.h"
 
+#include "FRep/Bounds.h"
+#include "FRep/Tape.h"
+
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -256,6 +259,41 @@ void saveModelFile(const ModelFile& model, const std::string& path)
       unknownExtension(path);
   }
   writeAtomically(path, text);
+}
+
+std::array<double, 6> modelFileBounds(const ModelFile& file, const std::vector<double>& parameters)
+{
+  if (file.bounds)
+  {
+    return *file.bounds;
+  }
+  constexpr double searchHalfWidth = 10.0;
+  const frep::Box search{ { -searchHalfWidth, -searchHalfWidth, -searchHalfWidth },
+    { searchHalfWidth, searchHalfWidth, searchHalfWidth } };
+  std::vector<double> values = parameters;
+  values.resize(std::max(values.size(), static_cast<std::size_t>(file.parameterCount)), 0.0);
+  std::optional<frep::Box> box;
+  try
+  {
+    box = frep::boundingBox(
+      frep::Tape::compile(file.model.geometry().function()), search, 6, 0.0, values);
+  }
+  catch (const std::invalid_argument&)
+  {
+    box = search;
+  }
+  const frep::Box b = box ? *box : search;
+  const std::uint8_t axes = frep::domainAxes(file.model.geometry().domain());
+  std::array<double, 6> bounds{};
+  for (int a = 0; a < 3; ++a)
+  {
+    const bool used = axes & (1u << a);
+    // A little margin, so the surface does not touch the grid's border.
+    const double pad = 0.02 * (b.hi[a] - b.lo[a]);
+    bounds[2 * a] = used ? b.lo[a] - pad : 0.0;
+    bounds[2 * a + 1] = used ? b.hi[a] + pad : 0.0;
+  }
+  return bounds;
 }
 
 } // namespace ictk::lang

@@ -30,6 +30,12 @@ bool isModelFile(const std::string& path);
 /// (see readHyperFun); an XML model keeps its parameter slots.
 ModelFile loadModelFile(const std::string& path, const Limits& limits = {},
   const std::vector<double>& parameterValues = {});
+/// A box {xmin, xmax, ymin, ymax, zmin, zmax} that holds the model: the file's own bounds when it
+/// carries them, else found by interval arithmetic (frep::boundingBox) inside [-10, 10]^3
+/// (HyperFun's default modelling box) with a 2 % margin, the axes the model's domain does not use
+/// flat at 0. A model whose parameters are needed to bound it gets the whole search box.
+std::array<double, 6> modelFileBounds(
+  const ModelFile& file, const std::vector<double>& parameters = {});
 /// Saves as .hf or .xml by extension, through a temporary file renamed on success.
 void saveModelFile(const ModelFile& model, const std::string& path);
 

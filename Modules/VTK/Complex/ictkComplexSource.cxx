@@ -15,6 +15,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseKey.h"
+#include "vtkInformationVector.h"
 #include "vtkIntArray.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMetaImageReader.h"
@@ -32,6 +33,7 @@
 #include "vtkPolyData.h"
 #include "vtkSTLReader.h"
 #include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
 #include "vtkTriangleFilter.h"
 #include "vtkUnstructuredGrid.h"
@@ -42,6 +44,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 
 vtkStandardNewMacro(ictkComplexSource);
@@ -348,7 +352,17 @@ void addField(vtkFieldData* fd, const char* name, V value)
 
 } // namespace
 
+struct ictkComplexSource::Internals
+{
+  /// The complex last read from FileName, and the file's time then (a changed file is read again).
+  std::string ReadPath;
+  std::filesystem::file_time_type ReadTime{};
+  std::shared_ptr<const complex::Complex> Read;
+  vtkSmartPointer<vtkDataAssembly> Assembly;
+};
+
 ictkComplexSource::ictkComplexSource()
+  : Internal(new Internals)
 {
   this->SetNumberOfInputPorts(0);
 }
@@ -369,10 +383,12 @@ complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path)
   return lang::readComplexFile(path, {}, readers);
 }
 
-void ictkComplexSource::Convert(const complex::Complex& k, const complex::ComplexMesh& mesh,
-  vtkPartitionedDataSetCollection* output, int volumeResolution)
+namespace
 {
-  output->Initialize();
+/// The assembly of a complex whose cells are the datasets of `layout`, in order.
+vtkSmartPointer<vtkDataAssembly> MakeAssembly(
+  const complex::Complex& k, const std::vector<complex::CellId>& layout)
+{
   auto assembly = vtkSmartPointer<vtkDataAssembly>::New();
   assembly->Initialize();
   assembly->SetRootNodeName(
@@ -383,33 +399,14 @@ void ictkComplexSource::Convert(const complex::Complex& k, const complex::Comple
     dimensionNodes[p] = assembly->AddNode(("dimension_" + std::to_string(p)).c_str());
   }
   std::map<complex::CellId, unsigned int> index;
-  unsigned int next = 0;
-  for (const complex::CellMesh& m : mesh.cells)
+  for (unsigned int i = 0; i < layout.size(); ++i)
   {
-    const complex::Cell& c = k.cell(m.cell);
-    auto part = vtkSmartPointer<vtkPartitionedDataSet>::New();
-    vtkSmartPointer<vtkPolyData> leaf = toPolyData(m);
-    part->SetPartition(0, leaf);
-    const auto* implicit = std::get_if<complex::ImplicitGeometry>(&c.geometry);
-    if (volumeResolution > 1 && c.dimension == 3 && implicit)
-    {
-      part->SetPartition(1, sampleVolume(*implicit, volumeResolution));
-    }
-    output->SetPartitionedDataSet(next, part);
-    output->GetMetaData(next)->Set(vtkCompositeDataSet::NAME(), c.name.c_str());
-    vtkFieldData* fd = part->GetFieldData();
-    addField<vtkIntArray>(fd, "CellId", static_cast<int>(c.id));
-    addField<vtkStringArray>(fd, "CellName", c.name);
-    addField<vtkStringArray>(fd, "CellKind", std::string(complex::kindCode(c.kind)));
-    addField<vtkIntArray>(fd, "CellDimension", c.dimension);
-    addField<vtkStringArray>(fd, "CellDescription", c.description);
-    // The XML writers keep only the leaves' field data: copy it there too.
-    leaf->GetFieldData()->ShallowCopy(fd);
+    const complex::Cell& c = k.cell(layout[i]);
     const int node = assembly->AddNode(
       vtkDataAssembly::MakeValidNodeName(c.name.c_str()).c_str(), dimensionNodes[c.dimension]);
     assembly->SetAttribute(node, "cell", c.name.c_str());
-    assembly->AddDataSetIndex(node, next);
-    index[c.id] = next++;
+    assembly->AddDataSetIndex(node, i);
+    index[c.id] = i;
   }
   // The relations: for each cell, a node listing the datasets of the related cells.
   const int relations = assembly->AddNode("relations");
@@ -430,7 +427,10 @@ void ictkComplexSource::Convert(const complex::Complex& k, const complex::Comple
     for (const auto& [id, dataset] : index)
     {
       (void)dataset;
-      const std::vector<complex::CellId> related = (k.*d.related)(id);
+      std::vector<complex::CellId> related = (k.*d.related)(id);
+      related.erase(std::remove_if(related.begin(), related.end(),
+                      [&](complex::CellId r) { return !index.count(r); }),
+        related.end());
       if (related.empty())
       {
         continue;
@@ -445,7 +445,59 @@ void ictkComplexSource::Convert(const complex::Complex& k, const complex::Comple
       }
     }
   }
-  output->SetDataAssembly(assembly);
+  return assembly;
+}
+} // namespace
+
+void ictkComplexSource::Convert(const complex::Complex& k, const complex::ComplexMesh& mesh,
+  vtkPartitionedDataSetCollection* output, int volumeResolution,
+  const std::vector<unsigned int>* layout)
+{
+  output->Initialize();
+  std::vector<complex::CellId> cells;
+  if (layout)
+  {
+    cells.assign(layout->begin(), layout->end());
+  }
+  else
+  {
+    for (const complex::CellMesh& m : mesh.cells)
+    {
+      cells.push_back(m.cell);
+    }
+  }
+  std::map<complex::CellId, const complex::CellMesh*> meshes;
+  for (const complex::CellMesh& m : mesh.cells)
+  {
+    meshes[m.cell] = &m;
+  }
+  for (unsigned int next = 0; next < cells.size(); ++next)
+  {
+    const complex::Cell& c = k.cell(cells[next]);
+    auto part = vtkSmartPointer<vtkPartitionedDataSet>::New();
+    vtkFieldData* fd = part->GetFieldData();
+    addField<vtkIntArray>(fd, "CellId", static_cast<int>(c.id));
+    addField<vtkStringArray>(fd, "CellName", c.name);
+    addField<vtkStringArray>(fd, "CellKind", std::string(complex::kindCode(c.kind)));
+    addField<vtkIntArray>(fd, "CellDimension", c.dimension);
+    addField<vtkStringArray>(fd, "CellDescription", c.description);
+    const auto found = meshes.find(c.id);
+    if (found != meshes.end())
+    {
+      vtkSmartPointer<vtkPolyData> leaf = toPolyData(*found->second);
+      part->SetPartition(0, leaf);
+      const auto* implicit = std::get_if<complex::ImplicitGeometry>(&c.geometry);
+      if (volumeResolution > 1 && c.dimension == 3 && implicit)
+      {
+        part->SetPartition(1, sampleVolume(*implicit, volumeResolution));
+      }
+      // The XML writers keep only the leaves' field data: copy it there too.
+      leaf->GetFieldData()->ShallowCopy(fd);
+    }
+    output->SetPartitionedDataSet(next, part);
+    output->GetMetaData(next)->Set(vtkCompositeDataSet::NAME(), c.name.c_str());
+  }
+  output->SetDataAssembly(MakeAssembly(k, cells));
 }
 
 void ictkComplexSource::ToMultiBlock(
@@ -475,32 +527,156 @@ void ictkComplexSource::ToMultiBlock(
   }
 }
 
+std::shared_ptr<const complex::Complex> ictkComplexSource::LoadComplex()
+{
+  const std::shared_ptr<const complex::Complex>& given = this->Complex;
+  const std::string& fileName = this->FileName;
+  Internals& internal = *this->Internal;
+  if (given)
+  {
+    return given;
+  }
+  if (fileName.empty())
+  {
+    throw std::invalid_argument("no complex: set FileName (a .json complex) or a complex in C++");
+  }
+  std::error_code ec;
+  const auto modified = std::filesystem::last_write_time(fileName, ec);
+  if (!internal.Read || internal.ReadPath != fileName || ec || modified != internal.ReadTime)
+  {
+    internal.Read.reset();
+    internal.Read =
+      std::make_shared<const complex::Complex>(ictkComplexSource::ReadComplexFile(fileName));
+    internal.ReadPath = fileName;
+    internal.ReadTime = modified;
+  }
+  return internal.Read;
+}
+
+void ictkComplexSource::AddSelector(const char* selector)
+{
+  if (selector && *selector)
+  {
+    this->Selectors.emplace_back(selector);
+    this->Modified();
+  }
+}
+
+void ictkComplexSource::ClearSelectors()
+{
+  if (!this->Selectors.empty())
+  {
+    this->Selectors.clear();
+    this->Modified();
+  }
+}
+
+const char* ictkComplexSource::GetSelector(int i) const
+{
+  return i >= 0 && i < static_cast<int>(this->Selectors.size())
+    ? this->Selectors[static_cast<std::size_t>(i)].c_str()
+    : nullptr;
+}
+
+vtkDataAssembly* ictkComplexSource::GetAssembly()
+{
+  return this->Internal->Assembly;
+}
+
+int ictkComplexSource::CanReadFile(const char* name)
+{
+  if (!name || !endsWith(name, ".json"))
+  {
+    return 0;
+  }
+  // A complex is a JSON object with a "cells" key; reading the head of the file is enough to
+  // tell it from other JSON files (ParaView offers every reader of an extension).
+  std::ifstream in(name, std::ios::binary);
+  std::string head(1 << 16, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const auto first = head.find_first_not_of(" \t\r\n");
+  return first != std::string::npos && head[first] == '{' &&
+      head.find("\"cells\"") != std::string::npos
+    ? 1
+    : 0;
+}
+
+int ictkComplexSource::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  try
+  {
+    const auto k = LoadComplex();
+    this->Internal->Assembly = MakeAssembly(*k, k->cellIds());
+  }
+  catch (const std::exception& e)
+  {
+    this->Internal->Assembly = nullptr;
+    vtkErrorMacro("" << e.what());
+    return 0;
+  }
+  outputVector->GetInformationObject(0)->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
+  return 1;
+}
+
 int ictkComplexSource::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkPartitionedDataSetCollection* output = vtkPartitionedDataSetCollection::GetData(outputVector);
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
   try
   {
-    std::shared_ptr<const complex::Complex> k = this->Complex;
-    if (!k)
+    const std::shared_ptr<const complex::Complex> k = LoadComplex();
+    const std::vector<complex::CellId> all = k->cellIds();
+    // The chosen cells, in the order of the collection.
+    std::vector<complex::CellId> chosen = all;
+    if (!this->Selectors.empty())
     {
-      if (this->FileName.empty())
+      const vtkSmartPointer<vtkDataAssembly> assembly = MakeAssembly(*k, all);
+      const std::vector<int> nodes = assembly->SelectNodes(this->Selectors);
+      std::vector<unsigned int> indices = assembly->GetDataSetIndices(nodes, true);
+      std::sort(indices.begin(), indices.end());
+      indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
+      chosen.clear();
+      for (unsigned int i : indices)
       {
-        vtkErrorMacro("no complex: set FileName (a .json complex) or a complex in C++");
-        return 0;
+        chosen.push_back(all[i]);
       }
-      k = std::make_shared<const complex::Complex>(ReadComplexFile(this->FileName));
+    }
+    const int pieces =
+      std::max(1, outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()));
+    const int piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+    std::vector<complex::CellId> share;
+    for (std::size_t i = 0; i < chosen.size(); ++i)
+    {
+      if (static_cast<int>(i % static_cast<std::size_t>(pieces)) == piece)
+      {
+        share.push_back(chosen[i]);
+      }
     }
     complex::DiscretizationOptions options;
-    options.featureSize = this->FeatureSize;
+    // The feature size of the whole complex, whatever part of it is discretised here.
+    options.featureSize =
+      this->FeatureSize > 0 ? this->FeatureSize : complex::defaultFeatureSize(*k);
     options.threads = this->NumberOfThreads;
     options.progress = [this](double fraction)
     {
       this->UpdateProgress(fraction);
       return !this->GetAbortExecute();
     };
-    const complex::ComplexMesh mesh = complex::discretizeComplex(*k, options);
-    Convert(*k, mesh, output, this->VolumeResolution);
+    complex::ComplexMesh mesh;
+    if (share.size() == all.size())
+    {
+      mesh = complex::discretizeComplex(*k, options);
+    }
+    else if (!share.empty())
+    {
+      options.cells = share;
+      mesh = complex::discretizeComplex(*k, options);
+    }
+    const std::vector<unsigned int> layout(all.begin(), all.end());
+    Convert(*k, mesh, output, this->VolumeResolution, &layout);
     vtkNew<ictkComplexHolder> holder;
     holder->Complex = k;
     output->GetInformation()->Set(COMPLEX(), holder);
@@ -523,6 +699,12 @@ void ictkComplexSource::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << this->FileName << "\n";
+  os << indent << "Selectors:";
+  for (const std::string& selector : this->Selectors)
+  {
+    os << " " << selector;
+  }
+  os << (this->Selectors.empty() ? " (none: every cell)\n" : "\n");
   os << indent << "FeatureSize: " << this->FeatureSize << "\n";
   os << indent << "VolumeResolution: " << this->VolumeResolution << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";

@@ -20,6 +20,16 @@
  *   /relations/coboundary/<cell>, /relations/contained_in/<cell>: the derived inverses;
  * each node carrying the cell name in its "cell" attribute (node names are made XML-valid).
  *
+ * Selectors (AddSelector, vtkDataAssembly paths such as "/dimension_2", "//petal_1" or
+ * "/relations/containment/Stem") choose the cells that are discretised; the output keeps a
+ * partitioned dataset for every cell, empty for the cells not chosen. The default, no selector,
+ * chooses every cell. GetAssembly() gives the assembly after UpdateInformation(), before any
+ * discretisation, so that a user (or ParaView's block selector) can choose.
+ *
+ * Pieces: under MPI (UPDATE_NUMBER_OF_PIECES > 1) the chosen cells are dealt to the pieces in
+ * turn (cell i of the chosen ones to piece i mod N); every piece has the same collection and
+ * assembly, with data only for its own cells, each equal to the one-process result.
+ *
  * Progress is reported per cell; AbortExecute cancels and leaves an empty output. Errors (a bad
  * file, an invalid relation, a cell that cannot be discretised) are reported with vtkErrorMacro
  * and the request fails.
@@ -31,7 +41,9 @@
 
 #include <memory> // for std::shared_ptr
 #include <string> // for std::string
+#include <vector> // for std::vector
 
+class vtkDataAssembly;
 class vtkDataObject;
 class vtkInformationObjectBaseKey;
 class vtkMultiBlockDataSet;
@@ -72,6 +84,21 @@ public:
   vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
   vtkGetMacro(NumberOfThreads, int);
 
+  ///@{
+  /// vtkDataAssembly selectors of the cells to discretise (none: every cell).
+  void AddSelector(const char* selector);
+  void ClearSelectors();
+  int GetNumberOfSelectors() const { return static_cast<int>(this->Selectors.size()); }
+  const char* GetSelector(int i) const;
+  ///@}
+
+  /// The complex's assembly (cells by dimension, relations), known after UpdateInformation().
+  vtkDataAssembly* GetAssembly();
+
+  /// 1 when `name` is a .json file whose top-level object has a "cells" list (a complex), so
+  /// that other JSON files are left to other readers.
+  static int CanReadFile(const char* name);
+
   /// Set on the output's information: the complex itself, so that downstream filters
   /// (ictkTetrahedralize) can use its fields, not only its discretisation.
   static vtkInformationObjectBaseKey* COMPLEX();
@@ -93,18 +120,23 @@ public:
     vtkDataObject* data, std::shared_ptr<const ictk::complex::Complex> complex);
   /// A complex built in C++; used instead of FileName when set.
   void SetComplex(std::shared_ptr<const ictk::complex::Complex> complex);
-  /// The VTK form of a discretised complex.
+  /// The VTK form of a discretised complex. `layout`: the cells that get a partitioned dataset,
+  /// in order (null: the mesh's cells); a cell of the layout that the mesh lacks gets an empty
+  /// one, so that every piece of a distributed complex has the same structure.
   static void Convert(const ictk::complex::Complex& complex, const ictk::complex::ComplexMesh& mesh,
-    vtkPartitionedDataSetCollection* output, int volumeResolution = 0);
+    vtkPartitionedDataSetCollection* output, int volumeResolution = 0,
+    const std::vector<unsigned int>* layout = nullptr);
 #endif
 
 protected:
   ictkComplexSource();
   ~ictkComplexSource() override;
 
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   std::string FileName;
+  std::vector<std::string> Selectors;
   double FeatureSize = 0;
   int VolumeResolution = 0;
   int NumberOfThreads = 0;
@@ -114,4 +146,10 @@ private:
   void operator=(const ictkComplexSource&) = delete;
 
   std::shared_ptr<const ictk::complex::Complex> Complex;
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+#ifndef __VTK_WRAP__
+  /// The complex given in C++, else the one read from FileName (read again when the file changed).
+  std::shared_ptr<const ictk::complex::Complex> LoadComplex();
+#endif
 };

@@ -1,14 +1,20 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkFRepSampler.h"
+#include "ictkFRepModel.h"
 
 #include "FRep/Hypervolume.h"
 #include "FRep/ModelRegistry.h"
 #include "FRep/Sampling.h"
+#include "Lang/Diagnostics.h"
+#include "Lang/ModelFile.h"
 
 #include "vtkAOSDataArrayTemplate.h"
+#include "vtkExtentTranslator.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationIntegerRequestKey.h"
 #include "vtkInformationVector.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkSmartPointer.h"
@@ -18,6 +24,8 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -34,53 +42,13 @@ struct Plan
   const frep::Hypervolume* hv = nullptr;
   frep::Grid grid;
   std::size_t bytesPerPoint = 0;
+  bool timeDependent = false;
 };
 } // namespace
 
 struct ictkFRepSampler::Internals
 {
-  /// Set by SetHypervolume(); wins over ModelName while set.
-  std::unique_ptr<frep::Hypervolume> Explicit;
-  /// The registered model last resolved from ModelName (built once per name, since building a
-  /// large model costs more than looking it up).
-  std::string ResolvedName;
-  std::unique_ptr<frep::Hypervolume> Resolved;
-  std::array<double, 3> ResolvedLo{ 0, 0, 0 };
-  std::array<double, 3> ResolvedHi{ 0, 0, 0 };
-  std::vector<double> Parameters;
-
-  /// The hypervolume to sample, or null with `error` set.
-  const frep::Hypervolume* Resolve(const char* modelName, std::string& error)
-  {
-    if (this->Explicit)
-    {
-      return this->Explicit.get();
-    }
-    if (!modelName || !*modelName)
-    {
-      error = "no model: set ModelName or call SetHypervolume()";
-      return nullptr;
-    }
-    if (this->Resolved && this->ResolvedName == modelName)
-    {
-      return this->Resolved.get();
-    }
-    this->Resolved.reset();
-    try
-    {
-      const frep::ModelInfo& info = frep::findModel(modelName);
-      this->Resolved = std::make_unique<frep::Hypervolume>(info.build());
-      this->ResolvedName = modelName;
-      this->ResolvedLo = info.boundsLo;
-      this->ResolvedHi = info.boundsHi;
-      return this->Resolved.get();
-    }
-    catch (const std::exception& e)
-    {
-      error = e.what();
-      return nullptr;
-    }
-  }
+  ictkFRepModel Model;
 
   bool MakePlan(ictkFRepSampler* self, Plan& plan, std::string& error);
 };
@@ -119,45 +87,131 @@ ictkFRepSampler::~ictkFRepSampler()
 {
   delete[] this->ModelName;
   this->ModelName = nullptr;
+  delete[] this->FileName;
+  this->FileName = nullptr;
+}
+
+namespace
+{
+/// Replaces a string property; true when it changed.
+bool ReplaceString(char*& member, const char* value)
+{
+  if ((!value && !member) || (value && member && std::strcmp(value, member) == 0))
+  {
+    return false;
+  }
+  delete[] member;
+  member = nullptr;
+  if (value)
+  {
+    member = new char[std::strlen(value) + 1];
+    std::strcpy(member, value);
+  }
+  return true;
+}
+
+std::string LowerExtension(const std::string& path)
+{
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext)
+  {
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return ext;
+}
+} // namespace
+
+void ictkFRepSampler::SetFileName(const char* name)
+{
+  const bool changed = ReplaceString(this->FileName, name && *name ? name : nullptr);
+  if (!changed && !this->Internal->Model.Explicit)
+  {
+    return;
+  }
+  if (this->FileName)
+  {
+    ReplaceString(this->ModelName, nullptr);
+  }
+  this->Internal->Model.Explicit.reset();
+  this->Internal->Model.ReadPath.clear(); // read again, even a file of the same name
+  this->Modified();
+}
+
+int ictkFRepSampler::CanReadFile(const char* name)
+{
+  if (!name || !ictk::lang::isModelFile(name))
+  {
+    return 0;
+  }
+  if (LowerExtension(name) != ".xml")
+  {
+    return 1;
+  }
+  // An XML file is an FRep model when its root element is <frep>: skip the declaration,
+  // comments and whitespace before it.
+  std::ifstream in(name, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  std::size_t at = 0;
+  while (true)
+  {
+    at = head.find('<', at);
+    if (at == std::string::npos || at + 1 >= head.size())
+    {
+      return 0;
+    }
+    if (head[at + 1] == '?' || head[at + 1] == '!')
+    {
+      ++at;
+      continue;
+    }
+    return head.compare(at + 1, 4, "frep") == 0 ? 1 : 0;
+  }
 }
 
 void ictkFRepSampler::SetModelName(const char* name)
 {
-  const bool same = (!name && !this->ModelName) ||
-    (name && this->ModelName && std::strcmp(name, this->ModelName) == 0);
-  if (same && !this->Internal->Explicit)
+  const bool changed = ReplaceString(this->ModelName, name);
+  if (!changed && !this->Internal->Model.Explicit && !(name && this->FileName))
   {
     return;
   }
-  delete[] this->ModelName;
-  this->ModelName = nullptr;
   if (name)
   {
-    this->ModelName = new char[std::strlen(name) + 1];
-    std::strcpy(this->ModelName, name);
+    ReplaceString(this->FileName, nullptr);
   }
-  this->Internal->Explicit.reset();
+  this->Internal->Model.Explicit.reset();
   this->Modified();
 }
 
 void ictkFRepSampler::SetHypervolume(const frep::Hypervolume& hv)
 {
-  this->Internal->Explicit = std::make_unique<frep::Hypervolume>(hv);
+  this->Internal->Model.Explicit = std::make_unique<frep::Hypervolume>(hv);
   this->Modified();
 }
 
 void ictkFRepSampler::SetParameters(const std::vector<double>& parameters)
 {
-  if (parameters != this->Internal->Parameters)
+  if (parameters != this->Internal->Model.Parameters)
   {
-    this->Internal->Parameters = parameters;
+    this->Internal->Model.Parameters = parameters;
+    // A HyperFun file is specialised to its parameter values when read: read it again.
+    this->Internal->Model.ReadPath.clear();
     this->Modified();
   }
 }
 
 const std::vector<double>& ictkFRepSampler::GetParameters() const
 {
-  return this->Internal->Parameters;
+  return this->Internal->Model.Parameters;
+}
+
+bool ictkFRepSampler::IsTimeDependent()
+{
+  Plan plan;
+  std::string error;
+  return this->Internal->MakePlan(this, plan, error) && plan.timeDependent;
 }
 
 int ictkFRepSampler::GetBytesPerPoint()
@@ -170,7 +224,7 @@ int ictkFRepSampler::GetBytesPerPoint()
 bool ictkFRepSampler::Internals::MakePlan(ictkFRepSampler* self, Plan& plan, std::string& error)
 {
   Internals& internal = *this;
-  plan.hv = internal.Resolve(self->GetModelName(), error);
+  plan.hv = internal.Model.Resolve(self->GetModelName(), self->GetFileName(), error);
   if (!plan.hv)
   {
     return false;
@@ -182,10 +236,10 @@ bool ictkFRepSampler::Internals::MakePlan(ictkFRepSampler* self, Plan& plan, std
     lo = { b[0], b[2], b[4] };
     hi = { b[1], b[3], b[5] };
   }
-  else if (!internal.Explicit)
+  else if (!internal.Model.Explicit)
   {
-    lo = internal.ResolvedLo;
-    hi = internal.ResolvedHi;
+    lo = internal.Model.ResolvedLo;
+    hi = internal.Model.ResolvedHi;
   }
   else
   {
@@ -209,6 +263,8 @@ bool ictkFRepSampler::Internals::MakePlan(ictkFRepSampler* self, Plan& plan, std
     resolution[a] = hi[a] > lo[a] ? dims[a] : std::min(dims[a], 1);
   }
   plan.grid = frep::gridOverBox(lo, hi, resolution, self->GetTime());
+  plan.timeDependent =
+    (frep::domainAxes(plan.hv->geometry().domain()) & (1u << static_cast<int>(frep::Axis::T))) != 0;
 
   const int type = self->GetOutputScalarType();
   if (type != VTK_FLOAT && type != VTK_DOUBLE)
@@ -253,16 +309,53 @@ int ictkFRepSampler::RequestInformation(
   outInfo->Set(vtkDataObject::SPACING(), plan.grid.spacing.data(), 3);
   outInfo->Set(vtkDataObject::ORIGIN(), plan.grid.origin.data(), 3);
   vtkDataObject::SetPointDataActiveScalarInfo(outInfo, this->OutputScalarType, 1);
+  outInfo->Set(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT(), 1);
+  outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  if (plan.timeDependent)
+  {
+    const double t0 = this->TimeRange[0], t1 = this->TimeRange[1];
+    if (!std::isfinite(t0) || !std::isfinite(t1) || t1 < t0)
+    {
+      vtkErrorMacro(<< "TimeRange must be finite with t0 <= t1, got " << t0 << ", " << t1);
+      return 0;
+    }
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), this->TimeRange, 2);
+    const int n = this->NumberOfTimeSteps;
+    if (n > 0)
+    {
+      std::vector<double> steps(static_cast<std::size_t>(n));
+      for (int i = 0; i < n; ++i)
+      {
+        steps[static_cast<std::size_t>(i)] =
+          n == 1 ? t0 : (i == n - 1 ? t1 : t0 + (t1 - t0) * i / static_cast<double>(n - 1));
+      }
+      outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), steps.data(), n);
+    }
+  }
   return 1;
 }
 
 namespace
 {
-template <typename T>
-void Sample(ictkFRepSampler* self, const Plan& plan, const std::vector<double>& parameters,
-  int threads, vtkImageData* output)
+/// The piece of `whole` inside `extent` (VTK's inclusive point extent).
+frep::Grid PieceOf(const frep::Grid& whole, const int extent[6])
 {
-  const std::int64_t n = plan.grid.pointCount();
+  frep::Grid piece = whole;
+  for (int a = 0; a < 3; ++a)
+  {
+    piece.first[a] = extent[2 * a];
+    piece.dimensions[a] = extent[2 * a + 1] - extent[2 * a] + 1;
+  }
+  return piece;
+}
+
+template <typename T>
+void Sample(ictkFRepSampler* self, const Plan& plan, const int extent[6],
+  const std::vector<double>& parameters, int threads, vtkImageData* output)
+{
+  const frep::Grid grid = PieceOf(plan.grid, extent);
+  const std::int64_t n = grid.pointCount();
   // Without attributes, sample the geometry alone (a hypervolume with no attribute).
   const frep::Hypervolume hv = self->GetComputeAttributes()
     ? *plan.hv
@@ -292,11 +385,9 @@ void Sample(ictkFRepSampler* self, const Plan& plan, const std::vector<double>& 
     throw frep::Cancelled();
   }
   // Geometry and attributes in one pass over one tape (shared sub-expressions computed once).
-  frep::sampleGrid(hv, plan.grid, f->GetPointer(0), attributePointers, options);
+  frep::sampleGrid(hv, grid, f->GetPointer(0), attributePointers, options);
 
-  const auto& d = plan.grid.dimensions;
-  output->SetExtent(
-    0, static_cast<int>(d[0] - 1), 0, static_cast<int>(d[1] - 1), 0, static_cast<int>(d[2] - 1));
+  output->SetExtent(const_cast<int*>(extent));
   output->SetOrigin(plan.grid.origin.data());
   output->SetSpacing(plan.grid.spacing.data());
   vtkPointData* pd = output->GetPointData();
@@ -326,16 +417,71 @@ int ictkFRepSampler::RequestData(
     vtkErrorMacro(<< error);
     return 0;
   }
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  if (plan.timeDependent && outInfo->Has(SDDP::UPDATE_TIME_STEP()))
+  {
+    plan.grid.time = outInfo->Get(SDDP::UPDATE_TIME_STEP());
+    if (!std::isfinite(plan.grid.time))
+    {
+      vtkErrorMacro(<< "the requested time is not a finite number");
+      return 0;
+    }
+  }
+  if (plan.timeDependent)
+  {
+    output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), plan.grid.time);
+  }
+  else
+  {
+    output->GetInformation()->Remove(vtkDataObject::DATA_TIME_STEP());
+  }
+  // The piece the pipeline asks for (the whole grid when it asks for nothing in particular).
+  const auto& d = plan.grid.dimensions;
+  const int whole[6] = { 0, static_cast<int>(d[0] - 1), 0, static_cast<int>(d[1] - 1), 0,
+    static_cast<int>(d[2] - 1) };
+  int extent[6];
+  std::copy(whole, whole + 6, extent);
+  if (outInfo->Has(SDDP::UPDATE_EXTENT()))
+  {
+    outInfo->Get(SDDP::UPDATE_EXTENT(), extent);
+    for (int a = 0; a < 3; ++a)
+    {
+      extent[2 * a] = std::max(extent[2 * a], whole[2 * a]);
+      extent[2 * a + 1] = std::min(extent[2 * a + 1], whole[2 * a + 1]);
+    }
+  }
+  if (extent[0] > extent[1] || extent[2] > extent[3] || extent[4] > extent[5])
+  {
+    return 1; // an empty piece (more ranks than slabs): nothing to sample
+  }
   this->UpdateProgress(0.0);
   try
   {
     if (this->OutputScalarType == VTK_FLOAT)
     {
-      Sample<float>(this, plan, this->Internal->Parameters, this->NumberOfThreads, output);
+      Sample<float>(
+        this, plan, extent, this->Internal->Model.Parameters, this->NumberOfThreads, output);
     }
     else
     {
-      Sample<double>(this, plan, this->Internal->Parameters, this->NumberOfThreads, output);
+      Sample<double>(
+        this, plan, extent, this->Internal->Model.Parameters, this->NumberOfThreads, output);
+    }
+    // Ghost levels: the points beyond the piece proper are marked, so that downstream filters
+    // and ParaView count every point and cell once over all pieces.
+    const int ghostLevels = outInfo->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS());
+    const int pieces = outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES());
+    if (ghostLevels > 0 && pieces > 1)
+    {
+      int proper[6];
+      vtkNew<vtkExtentTranslator> translator;
+      const int splitMode = outInfo->Has(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+        ? outInfo->Get(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+        : vtkExtentTranslator::BLOCK_MODE;
+      translator->PieceToExtentThreadSafe(outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()), pieces, 0,
+        const_cast<int*>(whole), proper, splitMode, 0);
+      output->GenerateGhostArray(proper);
     }
   }
   catch (const frep::Cancelled&)
@@ -365,7 +511,8 @@ void ictkFRepSampler::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "ModelName: " << (this->ModelName ? this->ModelName : "(none)") << "\n";
-  os << indent << "Hypervolume: " << (this->Internal->Explicit ? "set" : "(none)") << "\n";
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent << "Hypervolume: " << (this->Internal->Model.Explicit ? "set" : "(none)") << "\n";
   os << indent << "SampleDimensions: (" << this->SampleDimensions[0] << ", "
      << this->SampleDimensions[1] << ", " << this->SampleDimensions[2] << ")\n";
   os << indent << "ModelBounds: (" << this->ModelBounds[0] << ", " << this->ModelBounds[1] << ", "
@@ -373,6 +520,8 @@ void ictkFRepSampler::PrintSelf(ostream& os, vtkIndent indent)
      << this->ModelBounds[5] << ")" << (BoundsAreSet(this->ModelBounds) ? "" : " (model's own)")
      << "\n";
   os << indent << "Time: " << this->Time << "\n";
+  os << indent << "TimeRange: (" << this->TimeRange[0] << ", " << this->TimeRange[1] << ")\n";
+  os << indent << "NumberOfTimeSteps: " << this->NumberOfTimeSteps << "\n";
   os << indent << "OutputScalarType: "
      << (this->OutputScalarType == VTK_DOUBLE
             ? "double"
@@ -381,7 +530,7 @@ void ictkFRepSampler::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ComputeAttributes: " << (this->ComputeAttributes ? "on" : "off") << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "Parameters:";
-  for (double p : this->Internal->Parameters)
+  for (double p : this->Internal->Model.Parameters)
   {
     os << " " << p;
   }

@@ -3,9 +3,11 @@
  * @class ictkFRepSampler
  * @brief Samples an FRep hypervolume (geometry and attributes) on a vtkImageData.
  *
- * A source (no input). The model is either a registered model, chosen by name with
- * SetModelName() (the bundled models are registered on first use), or a hypervolume given through
- * the C++ setter SetHypervolume(); whichever was set last is sampled.
+ * A source (no input), and the reader of model files. The model is a registered model, chosen by
+ * name with SetModelName() (the bundled models are registered on first use), a model file given
+ * with SetFileName() (.hf HyperFun, .xml FRep XML, .vm Fidget SSA), or a hypervolume given through
+ * the C++ setter SetHypervolume(); whichever was set last is sampled. A file without bounds is
+ * bounded by interval arithmetic over [-10, 10]^3 (ictk::lang::modelFileBounds).
  *
  * Output point data:
  * - "f": the defining function (f >= 0 inside, the FRep convention), the active scalars;
@@ -17,6 +19,16 @@
  * bounds have zero extent (e.g. z of a 2D model) is sampled once, whatever SampleDimensions says.
  * A ModelBounds box with xmin > xmax (the default) means "the registered model's own bounds";
  * a hypervolume set through SetHypervolume() has none, so ModelBounds must then be set.
+ *
+ * Time: a model whose domain has the t axis (XYZT, XYT, ...) is time-dependent. The output then
+ * advertises TIME_RANGE (TimeRange) and TIME_STEPS (NumberOfTimeSteps evenly over it) and is
+ * sampled at the pipeline's UPDATE_TIME_STEP when there is one (DATA_TIME_STEP says which), else
+ * at Time. A model without t advertises no time.
+ *
+ * Pieces: the source produces any sub-extent of its whole extent (CAN_PRODUCE_SUB_EXTENT), so
+ * VTK's streaming and ParaView's ranks under MPI each sample their own slab (with the ghost
+ * levels the pipeline asks for, so contours of pieces stitch). A point's coordinates are computed
+ * from its index in the whole grid, so in double precision a piece equals the whole bit for bit.
  *
  * Sampling is multithreaded (TBB) and gives identical values for any NumberOfThreads. Progress is
  * reported through UpdateProgress(); setting AbortExecute stops the sampling and leaves an empty
@@ -71,6 +83,21 @@ public:
 
   ///@{
   /**
+   * A model file (.hf, .xml, .vm). Setting a file name replaces a model name or a hypervolume;
+   * an empty name clears it. Syntax errors are reported as "file:line:col: error: ...".
+   */
+  virtual void SetFileName(const char* name);
+  vtkGetStringMacro(FileName);
+  ///@}
+
+  /**
+   * 1 when `name` looks like a model file this reader opens: a .hf or .vm file, or a .xml file
+   * whose root element is <frep> (other XML files are left to other readers).
+   */
+  static int CanReadFile(const char* name);
+
+  ///@{
+  /**
    * Number of grid points along x, y, z (default 50, 50, 50).
    */
   vtkSetVector3Macro(SampleDimensions, int);
@@ -93,6 +120,22 @@ public:
   vtkSetMacro(Time, double);
   vtkGetMacro(Time, double);
   ///@}
+
+  ///@{
+  /**
+   * The time range advertised for a time-dependent model (default 0..1), and how many evenly
+   * spaced time steps are advertised over it (default 11; 0 advertises the range alone).
+   */
+  vtkSetVector2Macro(TimeRange, double);
+  vtkGetVector2Macro(TimeRange, double);
+  vtkSetClampMacro(NumberOfTimeSteps, int, 0, 100000);
+  vtkGetMacro(NumberOfTimeSteps, int);
+  ///@}
+
+  /**
+   * True when the model (resolved from the current settings) depends on t.
+   */
+  bool IsTimeDependent();
 
   ///@{
   /**
@@ -143,9 +186,12 @@ protected:
     vtkInformationVector* outputVector) override;
 
   char* ModelName = nullptr;
+  char* FileName = nullptr;
   int SampleDimensions[3] = { 50, 50, 50 };
   double ModelBounds[6] = { 1, -1, 1, -1, 1, -1 };
   double Time = 0.0;
+  double TimeRange[2] = { 0.0, 1.0 };
+  int NumberOfTimeSteps = 11;
   int OutputScalarType = VTK_FLOAT;
   bool ComputeAttributes = true;
   int NumberOfThreads = 0;

@@ -2,6 +2,7 @@
 #include "ictkTetrahedralize.h"
 
 #include "FRep/Sampling.h"
+#include "Mesh/Quality.h"
 #include "Mesh/TetMesh.h"
 #include "ictkComplexSource.h"
 #ifdef ICTK_HAVE_MESH_CGAL
@@ -109,6 +110,44 @@ void ictkTetrahedralize::Convert(const ictk::mesh::TetMesh& mesh, vtkUnstructure
   output->GetFieldData()->AddArray(names);
 }
 
+namespace
+{
+void AddNumber(vtkFieldData* fd, const char* name, double value)
+{
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name);
+  a->InsertNextValue(value);
+  fd->AddArray(a);
+}
+} // namespace
+
+void ictkTetrahedralize::AddQualityFields(const ictk::mesh::QualityReport& report, vtkFieldData* fd)
+{
+  AddNumber(fd, "MinDihedralAngle", report.minDihedralDegrees);
+  AddNumber(fd, "MaxDihedralAngle", report.maxDihedralDegrees);
+  AddNumber(fd, "MinDihedralAngle1Percentile", report.minDihedralPercentile1Degrees);
+  AddNumber(fd, "MaxRadiusEdgeRatio", report.maxRadiusEdgeRatio);
+  AddNumber(fd, "MeanRadiusEdgeRatio", report.meanRadiusEdgeRatio);
+  AddNumber(fd, "Volume", report.volume);
+  AddNumber(fd, "NonPositiveTetrahedra", static_cast<double>(report.nonPositive));
+  // Per material, in MaterialId order (MaterialNames names them).
+  vtkNew<vtkDoubleArray> volume;
+  volume->SetName("MaterialVolume");
+  vtkNew<vtkDoubleArray> count;
+  count->SetName("MaterialTetrahedra");
+  vtkNew<vtkDoubleArray> angle;
+  angle->SetName("MaterialMinDihedralAngle");
+  for (const auto& m : report.materials)
+  {
+    volume->InsertNextValue(m.volume);
+    count->InsertNextValue(static_cast<double>(m.tetrahedra));
+    angle->InsertNextValue(m.minDihedralDegrees);
+  }
+  fd->AddArray(volume);
+  fd->AddArray(count);
+  fd->AddArray(angle);
+}
+
 int ictkTetrahedralize::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -152,6 +191,7 @@ int ictkTetrahedralize::RequestData(
     }
 #endif
     Convert(mesh, output);
+    AddQualityFields(ictk::mesh::measureQuality(mesh), output->GetFieldData());
     return 1;
   }
   catch (const ictk::frep::Cancelled&)

@@ -7,7 +7,11 @@
  * ictkComplexSource::COMPLEX()). Output: a vtkUnstructuredGrid of linear tetrahedra with the
  * cell data MaterialId (1-based, one per 3D cell in ascending id), CellId (the complex's cell
  * id) and one array per attribute of the complex, sampled at the tetrahedra's centroids; the
- * field data MaterialNames lists the cells' names by material.
+ * field data MaterialNames lists the cells' names by material, and the quality report
+ * (ictk::mesh::measureQuality) is in the field data too: MinDihedralAngle, MaxDihedralAngle,
+ * MinDihedralAngle1Percentile (degrees), MaxRadiusEdgeRatio, MeanRadiusEdgeRatio, Volume,
+ * NonPositiveTetrahedra, and per material MaterialVolume, MaterialTetrahedra and
+ * MaterialMinDihedralAngle.
  *
  * Backend: CGAL Mesh_3 (labelled domain from the cells' fields, 1D cells and cell-cell curves
  * protected) or TetGen (from conforming multi-material boundary surfaces); both are optional
@@ -20,6 +24,7 @@
 #include "ictkFiltersMeshModule.h" // export macro
 #include "vtkUnstructuredGridAlgorithm.h"
 
+class vtkFieldData;
 class vtkUnstructuredGrid;
 
 #ifndef __VTK_WRAP__
@@ -28,7 +33,8 @@ namespace ictk
 namespace mesh
 {
 struct TetMesh;
-}
+struct QualityReport;
+} // namespace mesh
 } // namespace ictk
 #endif
 
@@ -69,6 +75,8 @@ public:
 #ifndef __VTK_WRAP__
   /// The VTK form of a tetrahedral mesh.
   static void Convert(const ictk::mesh::TetMesh& mesh, vtkUnstructuredGrid* output);
+  /// The quality report as one-value field arrays (names in the class comment).
+  static void AddQualityFields(const ictk::mesh::QualityReport& report, vtkFieldData* fd);
 #endif
 
 protected:
