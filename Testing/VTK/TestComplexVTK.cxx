@@ -3,12 +3,16 @@
 // file, the containment of an FRep ball in the voxel cell proved by validation, and the
 // partitioned dataset collection ictkComplexSource makes of them.
 
+#include "Complex/Discretization.h"
 #include "Complex/Validation.h"
 #include "ictkComplexSource.h"
+#include "ictkComplexValidator.h"
 #include "ictkTetrahedralize.h"
 
 #include <vtkCellData.h>
 #include <vtkCubeSource.h>
+#include <vtkDataAssembly.h>
+#include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkFloatArray.h>
 #include <vtkIdList.h>
@@ -21,6 +25,7 @@
 #include <vtkPolyData.h>
 #include <vtkSTLWriter.h>
 #include <vtkStringArray.h>
+#include <vtkTable.h>
 #include <vtkTetra.h>
 #include <vtkTriangleFilter.h>
 #include <vtkUnstructuredGrid.h>
@@ -279,4 +284,180 @@ TEST(ComplexVTK, TetrahedralizeFilterLabelsEveryTetrahedron)
   orphan->SetGlobalWarningDisplay(0);
   orphan->Update();
   EXPECT_EQ(orphan->GetOutput()->GetNumberOfCells(), 0);
+}
+
+namespace
+{
+std::string FlowerPath()
+{
+  return std::string(ICTK_DATA_DIR) + "/Models/flower/flower.json";
+}
+
+/// Points of each partitioned dataset of a collection (0 for an empty one).
+std::vector<vtkIdType> PointsPerCell(vtkPartitionedDataSetCollection* pdc)
+{
+  std::vector<vtkIdType> points;
+  for (unsigned int i = 0; i < pdc->GetNumberOfPartitionedDataSets(); ++i)
+  {
+    points.push_back(pdc->GetPartitionedDataSet(i)->GetNumberOfPoints());
+  }
+  return points;
+}
+
+/// The points of cell i's surface/curve/point partition, flattened.
+std::vector<double> Coordinates(vtkPartitionedDataSetCollection* pdc, unsigned int i)
+{
+  std::vector<double> xyz;
+  vtkPartitionedDataSet* part = pdc->GetPartitionedDataSet(i);
+  auto* leaf =
+    part->GetNumberOfPartitions() ? vtkPolyData::SafeDownCast(part->GetPartition(0)) : nullptr;
+  for (vtkIdType p = 0; leaf && p < leaf->GetNumberOfPoints(); ++p)
+  {
+    const double* q = leaf->GetPoint(p);
+    xyz.insert(xyz.end(), q, q + 3);
+  }
+  return xyz;
+}
+} // namespace
+
+// Selectors choose cells by the assembly; the collection keeps every cell's dataset, empty for
+// the others, and the chosen cells' meshes (attributes included) equal the whole discretisation.
+TEST(ComplexVTK, SelectorsDiscretiseOnlyTheChosenCells)
+{
+  vtkNew<ictkComplexSource> whole;
+  whole->SetFileName(FlowerPath().c_str());
+  whole->Update();
+  vtkPartitionedDataSetCollection* all = whole->GetOutput();
+  ASSERT_EQ(all->GetNumberOfPartitionedDataSets(), 12u);
+  ASSERT_NE(whole->GetAssembly(), nullptr);
+
+  vtkNew<ictkComplexSource> source;
+  source->SetFileName(FlowerPath().c_str());
+  source->AddSelector("//dimension_2");
+  source->AddSelector("//t_0^0"); // a node name made valid, as MakeValidNodeName does
+  source->UpdateInformation();
+  // The assembly is known before any discretisation.
+  vtkDataAssembly* assembly = source->GetAssembly();
+  ASSERT_NE(assembly, nullptr);
+  EXPECT_EQ(assembly->GetDataSetIndices(assembly->FindFirstNodeWithName("dimension_2")).size(), 2u);
+  source->ClearSelectors();
+  source->AddSelector("//dimension_2");
+  source->Update();
+  vtkPartitionedDataSetCollection* some = source->GetOutput();
+  ASSERT_EQ(some->GetNumberOfPartitionedDataSets(), 12u);
+  int chosen = 0;
+  for (unsigned int i = 0; i < 12; ++i)
+  {
+    auto* dim = vtkIntArray::SafeDownCast(
+      some->GetPartitionedDataSet(i)->GetFieldData()->GetArray("CellDimension"));
+    ASSERT_NE(dim, nullptr) << "every dataset keeps its cell's field data";
+    if (dim->GetValue(0) == 2)
+    {
+      ++chosen;
+      EXPECT_EQ(Coordinates(some, i), Coordinates(all, i)) << "cell " << i;
+      auto* leaf = vtkPolyData::SafeDownCast(some->GetPartitionedDataSet(i)->GetPartition(0));
+      auto* reference = vtkPolyData::SafeDownCast(all->GetPartitionedDataSet(i)->GetPartition(0));
+      ASSERT_EQ(
+        leaf->GetPointData()->GetNumberOfArrays(), reference->GetPointData()->GetNumberOfArrays());
+      for (int a = 0; a < reference->GetPointData()->GetNumberOfArrays(); ++a)
+      {
+        vtkDataArray* x = reference->GetPointData()->GetArray(a);
+        vtkDataArray* y = leaf->GetPointData()->GetArray(x->GetName());
+        ASSERT_NE(y, nullptr) << x->GetName();
+        for (vtkIdType t = 0; t < x->GetNumberOfTuples(); ++t)
+        {
+          for (int c = 0; c < x->GetNumberOfComponents(); ++c)
+          {
+            ASSERT_EQ(x->GetComponent(t, c), y->GetComponent(t, c)) << x->GetName();
+          }
+        }
+      }
+    }
+    else
+    {
+      EXPECT_EQ(some->GetPartitionedDataSet(i)->GetNumberOfPoints(), 0) << "cell " << i;
+    }
+  }
+  EXPECT_EQ(chosen, 2);
+}
+
+// Pieces (MPI ranks) share the cells out: every cell is discretised by exactly one piece, as the
+// whole run discretises it, and every piece has the whole structure.
+TEST(ComplexVTK, PiecesShareTheCellsOut)
+{
+  vtkNew<ictkComplexSource> whole;
+  whole->SetFileName(FlowerPath().c_str());
+  whole->Update();
+  const std::vector<vtkIdType> reference = PointsPerCell(whole->GetOutput());
+  std::vector<vtkIdType> merged(reference.size(), 0);
+  for (int piece = 0; piece < 3; ++piece)
+  {
+    vtkNew<ictkComplexSource> source;
+    source->SetFileName(FlowerPath().c_str());
+    source->UpdatePiece(piece, 3, 0);
+    vtkPartitionedDataSetCollection* part = source->GetOutput();
+    ASSERT_EQ(part->GetNumberOfPartitionedDataSets(), reference.size());
+    EXPECT_EQ(part->GetDataAssembly()->GetNumberOfChildren(0),
+      whole->GetOutput()->GetDataAssembly()->GetNumberOfChildren(0));
+    const std::vector<vtkIdType> points = PointsPerCell(part);
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+      if (points[i] > 0)
+      {
+        EXPECT_EQ(i % 3, static_cast<std::size_t>(piece)) << "cell " << i;
+        EXPECT_EQ(merged[i], 0) << "cell " << i << " discretised twice";
+        merged[i] = points[i];
+        EXPECT_EQ(Coordinates(part, static_cast<unsigned int>(i)),
+          Coordinates(whole->GetOutput(), static_cast<unsigned int>(i)));
+      }
+    }
+  }
+  EXPECT_EQ(merged, reference);
+}
+
+TEST(ComplexVTK, ValidatorTableMatchesTheCoreReport)
+{
+  vtkNew<ictkComplexSource> source;
+  source->SetFileName(FlowerPath().c_str());
+  vtkNew<ictkComplexValidator> validator;
+  validator->SetInputConnection(source->GetOutputPort());
+  validator->Update();
+  vtkTable* table = validator->GetOutput();
+
+  const ictk::complex::Complex k = ictkComplexSource::ReadComplexFile(FlowerPath());
+  const ictk::complex::ComplexMesh mesh = ictk::complex::discretizeComplex(k);
+  const ictk::complex::ValidationReport report = ictk::complex::validateComplex(k, mesh);
+  const std::size_t rows =
+    report.satisfied.size() + report.violated.size() + report.undeclared.size();
+  ASSERT_EQ(table->GetNumberOfRows(), static_cast<vtkIdType>(rows));
+  ASSERT_GT(rows, 10u);
+  auto* status = vtkStringArray::SafeDownCast(table->GetColumnByName("Status"));
+  auto* deviation = vtkDoubleArray::SafeDownCast(table->GetColumnByName("Deviation"));
+  ASSERT_NE(status, nullptr);
+  ASSERT_NE(deviation, nullptr);
+  // Violated first, then undeclared, then satisfied, each in the report's order.
+  vtkIdType r = static_cast<vtkIdType>(report.violated.size() + report.undeclared.size());
+  for (const auto& f : report.satisfied)
+  {
+    EXPECT_EQ(status->GetValue(r), "satisfied");
+    EXPECT_EQ(deviation->GetValue(r), f.deviation);
+    ++r;
+  }
+  EXPECT_EQ(table->GetFieldData()->GetArray("Valid")->GetTuple1(0), report.ok() ? 1 : 0);
+  EXPECT_EQ(table->GetFieldData()->GetArray("Tolerance")->GetTuple1(0), report.tolerance);
+}
+
+// The complex survives a shallow copy (ParaView's vtkPVPostFilter makes one after every output).
+TEST(ComplexVTK, ComplexSurvivesAShallowCopy)
+{
+  vtkNew<ictkComplexSource> source;
+  source->SetFileName(FlowerPath().c_str());
+  source->SetFeatureSize(0.1);
+  source->Update();
+  vtkNew<vtkPartitionedDataSetCollection> copy;
+  copy->ShallowCopy(source->GetOutput());
+  const auto k = ictkComplexSource::GetComplex(copy);
+  ASSERT_NE(k, nullptr);
+  EXPECT_EQ(k, ictkComplexSource::GetComplex(source->GetOutput()));
+  EXPECT_EQ(k->cellIds().size(), 12u);
 }

@@ -68,13 +68,28 @@ protected:
 vtkStandardNewMacro(ictkComplexHolder);
 } // namespace
 
+namespace
+{
+/// The field array that carries the complex through shallow copies: ParaView puts a
+/// vtkPVPostFilter after every output, whose ShallowCopy keeps field arrays (the same objects)
+/// but not the data object's information keys.
+constexpr const char* ComplexArrayName = "ICTKComplex";
+} // namespace
+
 std::shared_ptr<const ictk::complex::Complex> ictkComplexSource::GetComplex(vtkDataObject* data)
 {
   if (!data)
   {
     return nullptr;
   }
-  auto* holder = ictkComplexHolder::SafeDownCast(data->GetInformation()->Get(COMPLEX()));
+  if (auto* holder = ictkComplexHolder::SafeDownCast(data->GetInformation()->Get(COMPLEX())))
+  {
+    return holder->Complex;
+  }
+  vtkFieldData* fd = data->GetFieldData();
+  vtkAbstractArray* marker = fd ? fd->GetAbstractArray(ComplexArrayName) : nullptr;
+  auto* holder =
+    marker ? ictkComplexHolder::SafeDownCast(marker->GetInformation()->Get(COMPLEX())) : nullptr;
   return holder ? holder->Complex : nullptr;
 }
 
@@ -86,8 +101,16 @@ void ictkComplexSource::AttachComplex(
     return;
   }
   vtkNew<ictkComplexHolder> holder;
+  const int cells = complex ? static_cast<int>(complex->cellIds().size()) : 0;
   holder->Complex = std::move(complex);
   data->GetInformation()->Set(COMPLEX(), holder);
+  // The same holder on a field array (its value: the number of cells), which shallow copies
+  // share; see ComplexArrayName.
+  vtkNew<vtkIntArray> marker;
+  marker->SetName(ComplexArrayName);
+  marker->InsertNextValue(cells);
+  marker->GetInformation()->Set(COMPLEX(), holder);
+  data->GetFieldData()->AddArray(marker);
 }
 
 namespace
@@ -677,9 +700,7 @@ int ictkComplexSource::RequestData(
     }
     const std::vector<unsigned int> layout(all.begin(), all.end());
     Convert(*k, mesh, output, this->VolumeResolution, &layout);
-    vtkNew<ictkComplexHolder> holder;
-    holder->Complex = k;
-    output->GetInformation()->Set(COMPLEX(), holder);
+    AttachComplex(output, k);
     return 1;
   }
   catch (const frep::Cancelled&)

@@ -20,8 +20,9 @@
  *   /relations/coboundary/<cell>, /relations/contained_in/<cell>: the derived inverses;
  * each node carrying the cell name in its "cell" attribute (node names are made XML-valid).
  *
- * Selectors (AddSelector, vtkDataAssembly paths such as "/dimension_2", "//petal_1" or
- * "/relations/containment/Stem") choose the cells that are discretised; the output keeps a
+ * Selectors (AddSelector; vtkDataAssembly paths, which start at the root node named after the
+ * complex: "/flower/dimension_2", or anywhere with "//dimension_2", "//petal_1",
+ * "//containment/Stem") choose the cells that are discretised; the output keeps a
  * partitioned dataset for every cell, empty for the cells not chosen. The default, no selector,
  * chooses every cell. GetAssembly() gives the assembly after UpdateInformation(), before any
  * discretisation, so that a user (or ParaView's block selector) can choose.
@@ -99,8 +100,9 @@ public:
   /// that other JSON files are left to other readers.
   static int CanReadFile(const char* name);
 
-  /// Set on the output's information: the complex itself, so that downstream filters
-  /// (ictkTetrahedralize) can use its fields, not only its discretisation.
+  /// Set on the output's information, and on the information of its field array "ICTKComplex"
+  /// (so that shallow copies, such as ParaView's vtkPVPostFilter, keep it): the complex itself, so
+  /// that downstream filters (ictkTetrahedralize) can use its fields, not only its discretisation.
   static vtkInformationObjectBaseKey* COMPLEX();
 
   /// The cells as a vtkMultiBlockDataSet (blocks per dimension, then one per cell, named), for

@@ -202,6 +202,18 @@ void ictkFRepSampler::SetParameters(const std::vector<double>& parameters)
   }
 }
 
+void ictkFRepSampler::AddParameter(double value)
+{
+  std::vector<double> parameters = this->Internal->Model.Parameters;
+  parameters.push_back(value);
+  this->SetParameters(parameters);
+}
+
+void ictkFRepSampler::ClearParameters()
+{
+  this->SetParameters({});
+}
+
 const std::vector<double>& ictkFRepSampler::GetParameters() const
 {
   return this->Internal->Model.Parameters;

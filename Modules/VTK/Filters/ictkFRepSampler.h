@@ -69,6 +69,16 @@ public:
   vtkGetStringMacro(ModelName);
   ///@}
 
+  ///@{
+  /**
+   * The model's parameter values one at a time (Python, ParaView's Parameters property): a
+   * HyperFun file is specialised to them (`ictk eval --params`); a model that declares more
+   * parameters than are given is an error that says how many it needs.
+   */
+  void AddParameter(double value);
+  void ClearParameters();
+  ///@}
+
 #ifndef __VTK_WRAP__
   /**
    * Samples `hv` (copied) instead of a registered model. ModelBounds must be set.
