@@ -1174,6 +1174,14 @@ int Run(int argc, char** argv)
 
 int main(int argc, char** argv)
 {
+  // VTK's filters (Flying Edges, and vtkSampleFunction in `ictk bench`) on as many threads as
+  // ICTK's own: ParaView's VTK has no TBB backend and starts Sequential unless
+  // VTK_SMP_BACKEND_IN_USE names another.
+  if (std::string(vtkSMPTools::GetBackend()) == "Sequential" &&
+    !std::getenv("VTK_SMP_BACKEND_IN_USE"))
+  {
+    vtkSMPTools::SetBackend("STDThread");
+  }
   try
   {
     return Run(argc, argv);
