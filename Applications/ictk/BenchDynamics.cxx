@@ -42,8 +42,7 @@ DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, i
     options.coherent = coherent;
     options.threads = threads;
     // defaultFeatureSize is 1/64 of the largest side.
-    options.featureSize =
-      engine::CoherentDiscretizer::defaultFeatureSize(model.complex()) * 64.0 / divisions;
+    options.featureSize = complex::defaultFeatureSize(model.complex()) * 64.0 / divisions;
     engine::CoherentDiscretizer mesher(options);
     const double start = model.time();
     engineSeconds += Since(mark);

@@ -537,7 +537,7 @@ int RunModel(const RunModelOptions& o)
       if (!(o.FeatureSize > 0))
       {
         // From the model's start, so that the same model gives the same meshes whatever T0.
-        mesher.setFeatureSize(engine::CoherentDiscretizer::defaultFeatureSize(model.complex()));
+        mesher.setFeatureSize(complex::defaultFeatureSize(model.complex()));
       }
     }
     catch (const engine::ModelError& e)

@@ -203,7 +203,7 @@ TEST(EngineCoherence, AndyhausenCoherentEqualsFullRemeshing)
   const DynamicModel& b = a;
   a.start();
   CoherenceOptions options;
-  options.featureSize = CoherentDiscretizer::defaultFeatureSize(a.complex());
+  options.featureSize = ictk::complex::defaultFeatureSize(a.complex());
   CoherentDiscretizer coherent(options);
   options.coherent = false;
   CoherentDiscretizer full(options);

@@ -13,7 +13,7 @@ from vtkmodules.vtkFiltersCore import vtkContourFilter, vtkMassProperties, vtkTr
 from vtkmodules.vtkParallelCore import vtkMultiProcessController
 from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIdList
 from vtkmodules.vtkCommonDataModel import vtkTriangle
-from ictk import ictkFiltersComplex, ictkFiltersFRep
+from ictk import ictkFiltersComplex, ictkFiltersDynamics, ictkFiltersFRep
 
 DATA = sys.argv[1]
 controller = vtkMultiProcessController.GetGlobalController()
@@ -126,6 +126,30 @@ check(0 < local_cells < whole.GetNumberOfPartitionedDataSets(), f"rank {rank} di
 check(total(local_cells) == whole.GetNumberOfPartitionedDataSets(), f"cells over ranks {total(local_cells)}")
 check(total(mine.GetNumberOfPoints()) == whole.GetNumberOfPoints(),
       f"complex points over ranks {total(mine.GetNumberOfPoints())} vs {whole.GetNumberOfPoints()}")
+
+# The dynamic complex (thesis 5.1) at t = 4 (instance K3, 7 cells): shared out the same way.
+icm = f"{DATA}/Models/icm/ch5_1_disk_rectangle.icm"
+dynamic = OpenDataFile(icm)
+dynamic.TimeStepSize = 0.5
+dynamic.FeatureSize = 0.05
+dynamic.UpdatePipeline(4.0)
+frame = dynamic.GetClientSideObject().GetOutputDataObject(0)
+one_dynamic = ictkFiltersDynamics.ictkDynamicComplexSource()
+one_dynamic.SetFileName(icm)
+one_dynamic.SetTimeStepSize(0.5)
+one_dynamic.SetFeatureSize(0.05)
+one_dynamic.UpdateTimeStep(4.0)
+whole_frame = one_dynamic.GetOutput()
+n = whole_frame.GetNumberOfPartitionedDataSets()
+check(frame.GetNumberOfPartitionedDataSets() == n == 7, f"disk at t = 4: {frame.GetNumberOfPartitionedDataSets()} cells, {n} in one process")
+mine = [i for i in range(n) if frame.GetPartitionedDataSet(i).GetNumberOfPoints()]
+check(all(i % ranks == rank for i in mine), f"rank {rank}: disk cells {mine}")
+for i in mine:
+    check(frame.GetPartitionedDataSet(i).GetNumberOfPoints() == whole_frame.GetPartitionedDataSet(i).GetNumberOfPoints(),
+          f"rank {rank}: disk cell {i} points")
+check(total(frame.GetNumberOfPoints()) == whole_frame.GetNumberOfPoints(),
+      f"disk points over ranks {total(frame.GetNumberOfPoints())} vs {whole_frame.GetNumberOfPoints()}")
+check(frame.GetFieldData().GetAbstractArray("Instance").GetValue(0) == "K3", "disk at t = 4 is K3 on every rank")
 
 bad = total(len(failures))
 if rank == 0:

@@ -119,17 +119,6 @@ CoherentDiscretizer::CoherentDiscretizer(CoherenceOptions options)
 {
 }
 
-double CoherentDiscretizer::defaultFeatureSize(const complex::Complex& complex)
-{
-  const frep::Box3 b = complex::complexBounds(complex);
-  double side = 0;
-  for (int a = 0; a < 3; ++a)
-  {
-    side = std::max(side, b.hi[a] - b.lo[a]);
-  }
-  return side > 0 && std::isfinite(side) ? side / 64 : 1.0 / 64;
-}
-
 void CoherentDiscretizer::reset()
 {
   kept_.clear();
@@ -143,11 +132,11 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const DynamicModel& model)
   return discretize(model.cells(), model.complex());
 }
 
-complex::ComplexMesh CoherentDiscretizer::discretize(
-  const std::vector<CellState>& cells, const complex::Complex& complex)
+complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState>& cells,
+  const complex::Complex& complex, const std::vector<complex::CellId>& only)
 {
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<complex::CellId> ids = complex.cellIds();
+  std::vector<complex::CellId> ids = complex.cellIds();
   if (ids.size() != cells.size())
   {
     throw std::invalid_argument("the complex has " + std::to_string(ids.size()) +
@@ -155,7 +144,19 @@ complex::ComplexMesh CoherentDiscretizer::discretize(
   }
   if (!(featureSize_ > 0))
   {
-    featureSize_ = defaultFeatureSize(complex);
+    featureSize_ = complex::defaultFeatureSize(complex);
+  }
+  std::vector<complex::CellId> targets = only;
+  std::sort(targets.begin(), targets.end());
+  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+  if (!targets.empty())
+  {
+    ids = targets;
+    for (complex::CellId id : complex::attributeSupport(complex, targets, 0.25 * featureSize_))
+    {
+      ids.push_back(id);
+    }
+    std::sort(ids.begin(), ids.end());
   }
   complex::DiscretizationOptions o;
   o.featureSize = featureSize_;
@@ -248,12 +249,23 @@ complex::ComplexMesh CoherentDiscretizer::discretize(
   // Attributes are functions of world position: evaluated where the points are now, never kept.
   for (complex::CellMesh& m : mesh.cells)
   {
+    if (!targets.empty() && !std::binary_search(targets.begin(), targets.end(), m.cell))
+    {
+      continue; // a cell meshed only to locate points: its own attributes are not needed
+    }
     for (const auto& binding : complex.cell(m.cell).attributes)
     {
       complex::appendAttribute(binding, m.vertices(), m.pointData());
     }
   }
-  complex::appendUnboundAttributes(complex, mesh, 0.25 * featureSize_);
+  complex::appendUnboundAttributes(complex, mesh, 0.25 * featureSize_, targets);
+  if (!targets.empty())
+  {
+    mesh.cells.erase(std::remove_if(mesh.cells.begin(), mesh.cells.end(),
+                       [&](const complex::CellMesh& m)
+                       { return !std::binary_search(targets.begin(), targets.end(), m.cell); }),
+      mesh.cells.end());
+  }
   if (options_.progress && !options_.progress(1.0))
   {
     throw frep::Cancelled();

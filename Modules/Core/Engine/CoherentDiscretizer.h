@@ -81,8 +81,10 @@ public:
   /// then the declared defaults by priority, as complex::discretizeComplex gives them).
   complex::ComplexMesh discretize(const DynamicModel& model);
   /// The same for cells and the complex made from them (complex.cell(i) stands for cells[i]).
-  complex::ComplexMesh discretize(
-    const std::vector<CellState>& cells, const complex::Complex& complex);
+  /// `only`: discretise just these cells (an MPI rank's share; empty = all), each as in a whole
+  /// frame; the cells their unbound attributes are looked up in are meshed too, then dropped.
+  complex::ComplexMesh discretize(const std::vector<CellState>& cells,
+    const complex::Complex& complex, const std::vector<complex::CellId>& only = {});
 
   /// The feature size in use (0 before the first frame when none was given).
   double featureSize() const { return featureSize_; }
@@ -97,9 +99,6 @@ public:
   /// Forgets every kept mesh and the statistics; the feature size stays. Call it when the
   /// model is reloaded: shape versions are only meaningful within one run.
   void reset();
-
-  /// 1/64 of the largest side of the complex's box (complex::discretizeComplex's default).
-  static double defaultFeatureSize(const complex::Complex& complex);
 
 private:
   struct Kept

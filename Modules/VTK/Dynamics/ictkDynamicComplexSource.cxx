@@ -208,8 +208,7 @@ int ictkDynamicComplexSource::RequestInformation(
       if (!(this->FeatureSize > 0))
       {
         // Fixed from the model's start, whatever time is asked for first.
-        in.Mesher->setFeatureSize(
-          engine::CoherentDiscretizer::defaultFeatureSize(in.Model->complex()));
+        in.Mesher->setFeatureSize(ictk::complex::defaultFeatureSize(in.Model->complex()));
       }
       in.Configuration = configuration.str();
     }
@@ -218,6 +217,7 @@ int ictkDynamicComplexSource::RequestInformation(
       static_cast<int>(in.Steps.size()));
     const double range[2] = { in.Steps.front(), in.Steps.back() };
     outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+    outInfo->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
     return 1;
   }
   catch (const engine::ModelError& e)
@@ -285,8 +285,31 @@ int ictkDynamicComplexSource::RequestData(
 
     const std::vector<engine::CellState> cells = in.Model->cells();
     auto k = std::make_shared<const ictk::complex::Complex>(in.Model->complex());
-    const ictk::complex::ComplexMesh mesh = in.Mesher->discretize(cells, *k);
-    ictkComplexSource::Convert(*k, mesh, output);
+    // Under MPI every rank runs the engine (cheap, deterministic) and discretises its share of
+    // the cells (cell i to piece i mod N); every piece has the whole collection's structure.
+    const int pieces =
+      std::max(1, outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()));
+    const int piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+    const std::vector<ictk::complex::CellId> all = k->cellIds();
+    std::vector<ictk::complex::CellId> share;
+    for (std::size_t i = 0; i < all.size(); ++i)
+    {
+      if (static_cast<int>(i % static_cast<std::size_t>(pieces)) == piece)
+      {
+        share.push_back(all[i]);
+      }
+    }
+    ictk::complex::ComplexMesh mesh;
+    if (pieces == 1)
+    {
+      mesh = in.Mesher->discretize(cells, *k);
+    }
+    else if (!share.empty())
+    {
+      mesh = in.Mesher->discretize(cells, *k, share);
+    }
+    const std::vector<unsigned int> layout(all.begin(), all.end());
+    ictkComplexSource::Convert(*k, mesh, output, 0, &layout);
     ictkComplexSource::AttachComplex(output, k);
 
     this->InstanceName = in.Model->activeInstance();

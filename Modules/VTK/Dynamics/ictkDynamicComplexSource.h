@@ -19,6 +19,9 @@
  * shape did not change since it was last meshed is moved, not re-meshed. FeatureSize is the same
  * for every frame (0: 1/64 of the complex's size at the model's start).
  *
+ * Pieces: under MPI every rank runs the engine (it is cheap and deterministic) and discretises
+ * its share of the active instance's cells (cell i to piece i mod N), as ictkComplexSource does.
+ *
  * Progress is reported over the engine's run (first half) and the discretisation (second half);
  * AbortExecute cancels and leaves an empty output. A model that does not read or run is reported
  * with vtkErrorMacro ("file:line:col: error: ...") and the request fails.
