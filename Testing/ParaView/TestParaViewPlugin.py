@@ -175,6 +175,11 @@ assembly = pdc.GetDataAssembly()
 by_dimension = {d: len(assembly.GetDataSetIndices(assembly.FindFirstNodeWithName(f"dimension_{d}"))) for d in range(4)}
 expected_dims = {d: sum(1 for c in cells if c["dimension"] == d) for d in range(4)}
 check(by_dimension == expected_dims, f"flower by dimension {by_dimension} vs {expected_dims}")
+# The block selector (Properties panel) gets the reader's assembly before any discretisation.
+domain = flower.GetProperty("Selectors").SMProperty.FindDomain("vtkSMDataAssemblyDomain")
+check(domain is not None and domain.GetDataAssembly() is not None
+      and domain.GetDataAssembly().FindFirstNodeWithName("dimension_2") > 0,
+      "the Selectors property offers the complex's assembly")
 flower.Selectors = ["//dimension_2"]
 pdc = fetch(flower)
 for i in range(pdc.GetNumberOfPartitionedDataSets()):

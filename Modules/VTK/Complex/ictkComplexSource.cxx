@@ -632,6 +632,7 @@ int ictkComplexSource::RequestInformation(
   {
     const auto k = LoadComplex();
     this->Internal->Assembly = MakeAssembly(*k, k->cellIds());
+    ++this->AssemblyTag;
   }
   catch (const std::exception& e)
   {

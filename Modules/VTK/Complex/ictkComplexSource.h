@@ -95,6 +95,8 @@ public:
 
   /// The complex's assembly (cells by dimension, relations), known after UpdateInformation().
   vtkDataAssembly* GetAssembly();
+  /// Changes whenever GetAssembly() is rebuilt (ParaView's block selector fetches it then).
+  int GetAssemblyTag() const { return this->AssemblyTag; }
 
   /// 1 when `name` is a .json file whose top-level object has a "cells" list (a complex), so
   /// that other JSON files are left to other readers.
@@ -139,6 +141,7 @@ protected:
 
   std::string FileName;
   std::vector<std::string> Selectors;
+  int AssemblyTag = 0;
   double FeatureSize = 0;
   int VolumeResolution = 0;
   int NumberOfThreads = 0;
