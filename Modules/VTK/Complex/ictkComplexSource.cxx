@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkComplexSource.h"
+#include "ictkRequest.h"
 
 #include "Complex/Discretization.h"
 #include "FRep/Sampling.h"
@@ -649,72 +650,58 @@ int ictkComplexSource::RequestData(
 {
   vtkPartitionedDataSetCollection* output = vtkPartitionedDataSetCollection::GetData(outputVector);
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  try
-  {
-    const std::shared_ptr<const complex::Complex> k = LoadComplex();
-    const std::vector<complex::CellId> all = k->cellIds();
-    // The chosen cells, in the order of the collection.
-    std::vector<complex::CellId> chosen = all;
-    if (!this->Selectors.empty())
+  return ictk::vtk::runRequest(this, output,
+    [&]
     {
-      const vtkSmartPointer<vtkDataAssembly> assembly = MakeAssembly(*k, all);
-      const std::vector<int> nodes = assembly->SelectNodes(this->Selectors);
-      std::vector<unsigned int> indices = assembly->GetDataSetIndices(nodes, true);
-      std::sort(indices.begin(), indices.end());
-      indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
-      chosen.clear();
-      for (unsigned int i : indices)
+      const std::shared_ptr<const complex::Complex> k = LoadComplex();
+      const std::vector<complex::CellId> all = k->cellIds();
+      // The chosen cells, in the order of the collection.
+      std::vector<complex::CellId> chosen = all;
+      if (!this->Selectors.empty())
       {
-        chosen.push_back(all[i]);
+        const vtkSmartPointer<vtkDataAssembly> assembly = MakeAssembly(*k, all);
+        const std::vector<int> nodes = assembly->SelectNodes(this->Selectors);
+        std::vector<unsigned int> indices = assembly->GetDataSetIndices(nodes, true);
+        std::sort(indices.begin(), indices.end());
+        indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
+        chosen.clear();
+        for (unsigned int i : indices)
+        {
+          chosen.push_back(all[i]);
+        }
       }
-    }
-    const int pieces =
-      std::max(1, outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()));
-    const int piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
-    std::vector<complex::CellId> share;
-    for (std::size_t i = 0; i < chosen.size(); ++i)
-    {
-      if (static_cast<int>(i % static_cast<std::size_t>(pieces)) == piece)
+      const int pieces =
+        std::max(1, outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()));
+      const int piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+      std::vector<complex::CellId> share;
+      for (std::size_t i = 0; i < chosen.size(); ++i)
       {
-        share.push_back(chosen[i]);
+        if (static_cast<int>(i % static_cast<std::size_t>(pieces)) == piece)
+        {
+          share.push_back(chosen[i]);
+        }
       }
-    }
-    complex::DiscretizationOptions options;
-    // The feature size of the whole complex, whatever part of it is discretised here.
-    options.featureSize =
-      this->FeatureSize > 0 ? this->FeatureSize : complex::defaultFeatureSize(*k);
-    options.threads = this->NumberOfThreads;
-    options.progress = [this](double fraction)
-    {
-      this->UpdateProgress(fraction);
-      return !this->GetAbortExecute();
-    };
-    complex::ComplexMesh mesh;
-    if (share.size() == all.size())
-    {
-      mesh = complex::discretizeComplex(*k, options);
-    }
-    else if (!share.empty())
-    {
-      options.cells = share;
-      mesh = complex::discretizeComplex(*k, options);
-    }
-    const std::vector<unsigned int> layout(all.begin(), all.end());
-    Convert(*k, mesh, output, this->VolumeResolution, &layout);
-    AttachComplex(output, k);
-    return 1;
-  }
-  catch (const frep::Cancelled&)
-  {
-    output->Initialize();
-    return 1;
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro("" << e.what());
-    output->Initialize();
-    return 0;
-  }
+      complex::DiscretizationOptions options;
+      // The feature size of the whole complex, whatever part of it is discretised here.
+      options.featureSize =
+        this->FeatureSize > 0 ? this->FeatureSize : complex::defaultFeatureSize(*k);
+      options.threads = this->NumberOfThreads;
+      options.progress = ictk::vtk::progressOf(this);
+      complex::ComplexMesh mesh;
+      if (share.size() == all.size())
+      {
+        mesh = complex::discretizeComplex(*k, options);
+      }
+      else if (!share.empty())
+      {
+        options.cells = share;
+        mesh = complex::discretizeComplex(*k, options);
+      }
+      const std::vector<unsigned int> layout(all.begin(), all.end());
+      Convert(*k, mesh, output, this->VolumeResolution, &layout);
+      AttachComplex(output, k);
+      return 1;
+    });
 }
 
 void ictkComplexSource::PrintSelf(ostream& os, vtkIndent indent)

@@ -5,6 +5,7 @@
 #include "Complex/Validation.h"
 #include "FRep/Sampling.h"
 #include "ictkComplexSource.h"
+#include "ictkRequest.h"
 
 #include "vtkDataObject.h"
 #include "vtkDoubleArray.h"
@@ -41,81 +42,67 @@ int ictkComplexValidator::RequestData(
     vtkErrorMacro("the input carries no complex: connect an ictkComplexSource");
     return 0;
   }
-  try
-  {
-    complex::DiscretizationOptions d;
-    d.featureSize = this->FeatureSize;
-    d.threads = this->NumberOfThreads;
-    d.progress = [this](double fraction)
+  return ictk::vtk::runRequest(this, output,
+    [&]
     {
-      this->UpdateProgress(0.5 * fraction);
-      return !this->GetAbortExecute();
-    };
-    const complex::ComplexMesh mesh = complex::discretizeComplex(*k, d);
-    complex::ValidationOptions v;
-    v.tolerance = this->Tolerance;
-    v.findUndeclared = this->FindUndeclared;
-    const complex::ValidationReport report = complex::validateComplex(*k, mesh, v);
+      complex::DiscretizationOptions d;
+      d.featureSize = this->FeatureSize;
+      d.threads = this->NumberOfThreads;
+      d.progress = ictk::vtk::progressOf(this, 0, 0.5);
+      const complex::ComplexMesh mesh = complex::discretizeComplex(*k, d);
+      complex::ValidationOptions v;
+      v.tolerance = this->Tolerance;
+      v.findUndeclared = this->FindUndeclared;
+      const complex::ValidationReport report = complex::validateComplex(*k, mesh, v);
 
-    vtkNew<vtkStringArray> status, relation, first, second, reason;
-    status->SetName("Status");
-    relation->SetName("Relation");
-    first->SetName("First");
-    second->SetName("Second");
-    reason->SetName("Reason");
-    vtkNew<vtkDoubleArray> deviation, witness;
-    deviation->SetName("Deviation");
-    witness->SetName("Witness");
-    witness->SetNumberOfComponents(3);
-    const std::pair<const char*, const std::vector<complex::RelationFinding>*> groups[] = {
-      { "violated", &report.violated },
-      { "undeclared", &report.undeclared },
-      { "satisfied", &report.satisfied },
-    };
-    for (const auto& [name, findings] : groups)
-    {
-      for (const complex::RelationFinding& f : *findings)
+      vtkNew<vtkStringArray> status, relation, first, second, reason;
+      status->SetName("Status");
+      relation->SetName("Relation");
+      first->SetName("First");
+      second->SetName("Second");
+      reason->SetName("Reason");
+      vtkNew<vtkDoubleArray> deviation, witness;
+      deviation->SetName("Deviation");
+      witness->SetName("Witness");
+      witness->SetNumberOfComponents(3);
+      const std::pair<const char*, const std::vector<complex::RelationFinding>*> groups[] = {
+        { "violated", &report.violated },
+        { "undeclared", &report.undeclared },
+        { "satisfied", &report.satisfied },
+      };
+      for (const auto& [name, findings] : groups)
       {
-        status->InsertNextValue(name);
-        relation->InsertNextValue(
-          f.kind == complex::RelationKind::Boundary ? "boundary" : "containment");
-        first->InsertNextValue(k->cell(f.first).name);
-        second->InsertNextValue(k->cell(f.second).name);
-        deviation->InsertNextValue(f.deviation);
-        witness->InsertNextTuple(f.witness.data());
-        reason->InsertNextValue(f.reason);
+        for (const complex::RelationFinding& f : *findings)
+        {
+          status->InsertNextValue(name);
+          relation->InsertNextValue(
+            f.kind == complex::RelationKind::Boundary ? "boundary" : "containment");
+          first->InsertNextValue(k->cell(f.first).name);
+          second->InsertNextValue(k->cell(f.second).name);
+          deviation->InsertNextValue(f.deviation);
+          witness->InsertNextTuple(f.witness.data());
+          reason->InsertNextValue(f.reason);
+        }
       }
-    }
-    output->Initialize();
-    output->AddColumn(status);
-    output->AddColumn(relation);
-    output->AddColumn(first);
-    output->AddColumn(second);
-    output->AddColumn(deviation);
-    output->AddColumn(witness);
-    output->AddColumn(reason);
-    vtkNew<vtkIntArray> valid;
-    valid->SetName("Valid");
-    valid->InsertNextValue(report.ok() ? 1 : 0);
-    output->GetFieldData()->AddArray(valid);
-    vtkNew<vtkDoubleArray> tolerance;
-    tolerance->SetName("Tolerance");
-    tolerance->InsertNextValue(report.tolerance);
-    output->GetFieldData()->AddArray(tolerance);
-    this->UpdateProgress(1.0);
-    return 1;
-  }
-  catch (const ictk::frep::Cancelled&)
-  {
-    output->Initialize();
-    return 1;
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro("" << e.what());
-    output->Initialize();
-    return 0;
-  }
+      output->Initialize();
+      output->AddColumn(status);
+      output->AddColumn(relation);
+      output->AddColumn(first);
+      output->AddColumn(second);
+      output->AddColumn(deviation);
+      output->AddColumn(witness);
+      output->AddColumn(reason);
+      vtkNew<vtkIntArray> valid;
+      valid->SetName("Valid");
+      valid->InsertNextValue(report.ok() ? 1 : 0);
+      output->GetFieldData()->AddArray(valid);
+      vtkNew<vtkDoubleArray> tolerance;
+      tolerance->SetName("Tolerance");
+      tolerance->InsertNextValue(report.tolerance);
+      output->GetFieldData()->AddArray(tolerance);
+      this->UpdateProgress(1.0);
+      return 1;
+    });
 }
 
 void ictkComplexValidator::PrintSelf(ostream& os, vtkIndent indent)

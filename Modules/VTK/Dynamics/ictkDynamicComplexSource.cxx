@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkDynamicComplexSource.h"
+#include "ictkRequest.h"
 
 #include "Engine/CoherentDiscretizer.h"
 #include "Engine/DynamicModel.h"
@@ -199,11 +200,7 @@ int ictkDynamicComplexSource::RequestInformation(
       mesherOptions.featureSize = this->FeatureSize;
       mesherOptions.coherent = this->Coherent != 0;
       mesherOptions.threads = this->NumberOfThreads;
-      mesherOptions.progress = [this](double fraction)
-      {
-        this->UpdateProgress(0.5 + 0.5 * fraction);
-        return !this->GetAbortExecute();
-      };
+      mesherOptions.progress = ictk::vtk::progressOf(this, 0.5, 1.0);
       in.Mesher = std::make_unique<engine::CoherentDiscretizer>(std::move(mesherOptions));
       if (!(this->FeatureSize > 0))
       {

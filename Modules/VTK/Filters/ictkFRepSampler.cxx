@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkFRepSampler.h"
 #include "ictkFRepModel.h"
+#include "ictkRequest.h"
 
 #include "FRep/Hypervolume.h"
 #include "FRep/ModelRegistry.h"
@@ -387,11 +388,7 @@ void Sample(ictkFRepSampler* self, const Plan& plan, const int extent[6],
   frep::SampleOptions options;
   options.threads = threads;
   options.parameters = parameters;
-  options.progress = [self](double fraction)
-  {
-    self->UpdateProgress(fraction);
-    return !self->GetAbortExecute();
-  };
+  options.progress = ictk::vtk::progressOf(self);
   if (self->GetAbortExecute())
   {
     throw frep::Cancelled();
@@ -468,52 +465,49 @@ int ictkFRepSampler::RequestData(
     return 1; // an empty piece (more ranks than slabs): nothing to sample
   }
   this->UpdateProgress(0.0);
-  try
-  {
-    if (this->OutputScalarType == VTK_FLOAT)
+  const int ok = ictk::vtk::runRequest(this, output,
+    [&]
     {
-      Sample<float>(
-        this, plan, extent, this->Internal->Model.Parameters, this->NumberOfThreads, output);
-    }
-    else
-    {
-      Sample<double>(
-        this, plan, extent, this->Internal->Model.Parameters, this->NumberOfThreads, output);
-    }
-    // Ghost levels: the points beyond the piece proper are marked, so that downstream filters
-    // and ParaView count every point and cell once over all pieces.
-    const int ghostLevels = outInfo->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS());
-    const int pieces = outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES());
-    if (ghostLevels > 0 && pieces > 1)
-    {
-      int proper[6];
-      vtkNew<vtkExtentTranslator> translator;
-      const int splitMode = outInfo->Has(vtkExtentTranslator::UPDATE_SPLIT_MODE())
-        ? outInfo->Get(vtkExtentTranslator::UPDATE_SPLIT_MODE())
-        : vtkExtentTranslator::BLOCK_MODE;
-      translator->PieceToExtentThreadSafe(outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()), pieces, 0,
-        const_cast<int*>(whole), proper, splitMode, 0);
-      output->GenerateGhostArray(proper);
-    }
-  }
-  catch (const frep::Cancelled&)
+      try
+      {
+        if (this->OutputScalarType == VTK_FLOAT)
+        {
+          Sample<float>(
+            this, plan, extent, this->Internal->Model.Parameters, this->NumberOfThreads, output);
+        }
+        else
+        {
+          Sample<double>(
+            this, plan, extent, this->Internal->Model.Parameters, this->NumberOfThreads, output);
+        }
+      }
+      catch (const std::bad_alloc&)
+      {
+        throw std::runtime_error("out of memory sampling " +
+          std::to_string(plan.grid.dimensions[0]) + " x " +
+          std::to_string(plan.grid.dimensions[1]) + " x " +
+          std::to_string(plan.grid.dimensions[2]) + " points");
+      }
+      // Ghost levels: the points beyond the piece proper are marked, so that downstream filters
+      // and ParaView count every point and cell once over all pieces.
+      const int ghostLevels = outInfo->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS());
+      const int pieces = outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES());
+      if (ghostLevels > 0 && pieces > 1)
+      {
+        int proper[6];
+        vtkNew<vtkExtentTranslator> translator;
+        const int splitMode = outInfo->Has(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+          ? outInfo->Get(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+          : vtkExtentTranslator::BLOCK_MODE;
+        translator->PieceToExtentThreadSafe(outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()), pieces, 0,
+          const_cast<int*>(whole), proper, splitMode, 0);
+        output->GenerateGhostArray(proper);
+      }
+      return 1;
+    });
+  if (!ok || output->GetNumberOfPoints() == 0)
   {
-    // Aborting is a request, not a failure: leave an empty output, as VTK algorithms do.
-    output->Initialize();
-    return 1;
-  }
-  catch (const std::bad_alloc&)
-  {
-    output->Initialize();
-    vtkErrorMacro(<< "out of memory sampling " << plan.grid.dimensions[0] << " x "
-                  << plan.grid.dimensions[1] << " x " << plan.grid.dimensions[2] << " points");
-    return 0;
-  }
-  catch (const std::exception& e)
-  {
-    output->Initialize();
-    vtkErrorMacro(<< e.what());
-    return 0;
+    return ok;
   }
   this->UpdateProgress(1.0);
   return 1;

@@ -5,6 +5,7 @@
 #include "Mesh/Quality.h"
 #include "Mesh/TetMesh.h"
 #include "ictkComplexSource.h"
+#include "ictkRequest.h"
 #ifdef ICTK_HAVE_MESH_CGAL
 #include "Mesh/CGAL/MeshCgal.h"
 #endif
@@ -170,41 +171,27 @@ int ictkTetrahedralize::RequestData(
   options.deterministic = this->Deterministic;
   options.maxTetrahedra = this->MaxTetrahedra;
   options.threads = this->NumberOfThreads;
-  options.progress = [this](double fraction)
-  {
-    this->UpdateProgress(fraction);
-    return !this->GetAbortExecute();
-  };
-  try
-  {
-    ictk::mesh::TetMesh mesh;
-#ifdef ICTK_HAVE_MESH_CGAL
-    if (this->Backend == CGAL)
+  options.progress = ictk::vtk::progressOf(this);
+  return ictk::vtk::runRequest(this, output,
+    [&]
     {
-      mesh = ictk::mesh::tetrahedralizeCgal(*complex, options);
-    }
+      ictk::mesh::TetMesh mesh;
+#ifdef ICTK_HAVE_MESH_CGAL
+      if (this->Backend == CGAL)
+      {
+        mesh = ictk::mesh::tetrahedralizeCgal(*complex, options);
+      }
 #endif
 #ifdef ICTK_HAVE_MESH_TETGEN
-    if (this->Backend == TETGEN)
-    {
-      mesh = ictk::mesh::tetrahedralizeTetGen(*complex, options);
-    }
+      if (this->Backend == TETGEN)
+      {
+        mesh = ictk::mesh::tetrahedralizeTetGen(*complex, options);
+      }
 #endif
-    Convert(mesh, output);
-    AddQualityFields(ictk::mesh::measureQuality(mesh), output->GetFieldData());
-    return 1;
-  }
-  catch (const ictk::frep::Cancelled&)
-  {
-    output->Initialize();
-    return 1;
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro("" << e.what());
-    output->Initialize();
-    return 0;
-  }
+      Convert(mesh, output);
+      AddQualityFields(ictk::mesh::measureQuality(mesh), output->GetFieldData());
+      return 1;
+    });
 }
 
 void ictkTetrahedralize::PrintSelf(ostream& os, vtkIndent indent)
