@@ -1,0 +1,48 @@
+# ictk_add_core_library: the one way a library of the VTK-free core (Modules/Core/<Name>) is made.
+#
+#   ictk_add_core_library(<Name>
+#     SOURCES <file>...
+#     DEPENDS <ICTK core library>...          # public: its headers include theirs
+#     PRIVATE_DEPENDS <ICTK core library>...  # used by its sources only
+#     LINK <target>... PRIVATE_LINK <target>...)   # external libraries (TBB::tbb, Eigen3::Eigen...)
+#
+# makes the static library ictk<Name>, its alias ICTK::<Name> (also its installed name), includes
+# "<Name>/Header.h" from Modules/Core (build) or include/ictk (install), links ICTK::BuildFlags
+# privately, and records the ICTK dependencies in the global property ICTK_CORE_GRAPH, from which
+# build/ictk-core-graph.txt is written (ictk_write_core_graph) and checked against
+# docs/architecture.md by the test Docs.ArchitectureGraph.
+function(ictk_add_core_library name)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "" "SOURCES;DEPENDS;PRIVATE_DEPENDS;LINK;PRIVATE_LINK")
+  if(arg_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "ictk_add_core_library(${name}): unknown arguments ${arg_UNPARSED_ARGUMENTS}")
+  endif()
+  set(target ictk${name})
+  add_library(${target} ${arg_SOURCES})
+  add_library(ICTK::${name} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
+  target_include_directories(${target} PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/Modules/Core>
+    $<INSTALL_INTERFACE:include/ictk>)
+  list(TRANSFORM arg_DEPENDS PREPEND "ICTK::" OUTPUT_VARIABLE public_targets)
+  list(TRANSFORM arg_PRIVATE_DEPENDS PREPEND "ICTK::" OUTPUT_VARIABLE private_targets)
+  target_link_libraries(${target}
+    PUBLIC ${public_targets} ${arg_LINK}
+    PRIVATE ${private_targets} ${arg_PRIVATE_LINK} ICTK::BuildFlags)
+  set(edges "${name}:")
+  foreach(dependency IN LISTS arg_DEPENDS)
+    string(APPEND edges " ${dependency}")
+  endforeach()
+  foreach(dependency IN LISTS arg_PRIVATE_DEPENDS)
+    string(APPEND edges " ${dependency}(private)")
+  endforeach()
+  set_property(GLOBAL APPEND PROPERTY ICTK_CORE_GRAPH "${edges}")
+  set_property(GLOBAL APPEND PROPERTY ICTK_CORE_LIBRARIES ${target})
+endfunction()
+
+# Writes the recorded graph, one line per library ("Name: Dep Dep(private)"), sorted.
+function(ictk_write_core_graph file)
+  get_property(graph GLOBAL PROPERTY ICTK_CORE_GRAPH)
+  list(SORT graph)
+  list(JOIN graph "\n" text)
+  file(WRITE ${file} "${text}\n")
+endfunction()
