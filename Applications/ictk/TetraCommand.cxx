@@ -5,15 +5,10 @@
 #include "ComplexCommands.h"
 #include "FRep/Sampling.h"
 #include "Mesh/Attributes.h"
+#include "Mesh/Backends/Backends.h"
 #include "Mesh/Quality.h"
 #include "Mesh/Writers.h"
 #include "ictkTetrahedralize.h"
-#ifdef ICTK_HAVE_MESH_CGAL
-#include "Mesh/CGAL/MeshCgal.h"
-#endif
-#ifdef ICTK_HAVE_MESH_TETGEN
-#include "Mesh/TetGen/MeshTetGen.h"
-#endif
 
 #include <vtkNew.h>
 #include <vtkUnstructuredGrid.h>
@@ -30,6 +25,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 
 namespace ictk::cli
@@ -42,17 +38,6 @@ bool EndsWith(std::string s, const std::string& suffix)
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
   return s.size() >= suffix.size() &&
     s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-std::string DefaultBackend()
-{
-#ifdef ICTK_HAVE_MESH_CGAL
-  return "cgal";
-#elif defined(ICTK_HAVE_MESH_TETGEN)
-  return "tetgen";
-#else
-  return "";
-#endif
 }
 
 /// .vtu through VTK's writer, into a temporary file renamed on success.
@@ -105,13 +90,17 @@ int RunTetra(const TetraOptions& o)
   {
     throw std::invalid_argument("-o: '" + o.Output + "' is not a .vtu, .msh, .inp or .mesh file");
   }
-  const std::string backend = o.Backend.empty() ? DefaultBackend() : o.Backend;
-  if (backend != "cgal" && backend != "tetgen")
+  const std::optional<mesh::Backend> chosen =
+    o.Backend.empty() ? mesh::defaultBackend() : mesh::backendFromName(o.Backend);
+  if (!chosen)
   {
-    throw std::invalid_argument("--backend must be cgal or tetgen, not '" + backend + "'");
+    throw std::invalid_argument(o.Backend.empty()
+        ? std::string(
+            "no tetrahedral backend was built (configure with ICTK_ENABLE_GPL_BACKENDS=ON)")
+        : "--backend must be cgal or tetgen, not '" + o.Backend + "'");
   }
-  if (!ictkTetrahedralize::HasBackend(
-        backend == "cgal" ? ictkTetrahedralize::CGAL : ictkTetrahedralize::TETGEN))
+  const std::string backend = mesh::backendName(*chosen);
+  if (!mesh::hasBackend(*chosen))
   {
     throw std::invalid_argument("the " + backend +
       " backend was not built (configure with ICTK_ENABLE_GPL_BACKENDS=ON and its library)");
@@ -141,19 +130,7 @@ int RunTetra(const TetraOptions& o)
     }
     return true;
   };
-  mesh::TetMesh m;
-#ifdef ICTK_HAVE_MESH_CGAL
-  if (backend == "cgal")
-  {
-    m = mesh::tetrahedralizeCgal(k, options);
-  }
-#endif
-#ifdef ICTK_HAVE_MESH_TETGEN
-  if (backend == "tetgen")
-  {
-    m = mesh::tetrahedralizeTetGen(k, options);
-  }
-#endif
+  mesh::TetMesh m = mesh::tetrahedralize(k, *chosen, options);
   if (terminal)
   {
     std::fprintf(stderr, "\n");

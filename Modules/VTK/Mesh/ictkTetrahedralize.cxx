@@ -2,16 +2,11 @@
 #include "ictkTetrahedralize.h"
 
 #include "FRep/Sampling.h"
+#include "Mesh/Backends/Backends.h"
 #include "Mesh/Quality.h"
 #include "Mesh/TetMesh.h"
 #include "ictkComplexSource.h"
 #include "ictkRequest.h"
-#ifdef ICTK_HAVE_MESH_CGAL
-#include "Mesh/CGAL/MeshCgal.h"
-#endif
-#ifdef ICTK_HAVE_MESH_TETGEN
-#include "Mesh/TetGen/MeshTetGen.h"
-#endif
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
@@ -35,22 +30,18 @@ vtkStandardNewMacro(ictkTetrahedralize);
 ictkTetrahedralize::ictkTetrahedralize() = default;
 ictkTetrahedralize::~ictkTetrahedralize() = default;
 
+namespace
+{
+ictk::mesh::Backend BackendOf(int backend)
+{
+  return backend == ictkTetrahedralize::CGAL ? ictk::mesh::Backend::Cgal
+                                             : ictk::mesh::Backend::TetGen;
+}
+} // namespace
+
 bool ictkTetrahedralize::HasBackend(int backend)
 {
-#ifdef ICTK_HAVE_MESH_CGAL
-  if (backend == CGAL)
-  {
-    return true;
-  }
-#endif
-#ifdef ICTK_HAVE_MESH_TETGEN
-  if (backend == TETGEN)
-  {
-    return true;
-  }
-#endif
-  (void)backend;
-  return false;
+  return ictk::mesh::hasBackend(BackendOf(backend));
 }
 
 int ictkTetrahedralize::FillInputPortInformation(int, vtkInformation* info)
@@ -175,19 +166,8 @@ int ictkTetrahedralize::RequestData(
   return ictk::vtk::runRequest(this, output,
     [&]
     {
-      ictk::mesh::TetMesh mesh;
-#ifdef ICTK_HAVE_MESH_CGAL
-      if (this->Backend == CGAL)
-      {
-        mesh = ictk::mesh::tetrahedralizeCgal(*complex, options);
-      }
-#endif
-#ifdef ICTK_HAVE_MESH_TETGEN
-      if (this->Backend == TETGEN)
-      {
-        mesh = ictk::mesh::tetrahedralizeTetGen(*complex, options);
-      }
-#endif
+      const ictk::mesh::TetMesh mesh =
+        ictk::mesh::tetrahedralize(*complex, BackendOf(this->Backend), options);
       Convert(mesh, output);
       AddQualityFields(ictk::mesh::measureQuality(mesh), output->GetFieldData());
       return 1;
