@@ -680,13 +680,7 @@ int RunModel(const RunModelOptions& o)
               << ", feature size " << std::setprecision(6) << mesher.featureSize() << ")\n";
     return 0;
   }
-  catch (const engine::RunCancelled&)
-  {
-    bar.end();
-    std::cerr << "ictk: interrupted; nothing written\n";
-    return ExitInterrupted;
-  }
-  catch (const frep::Cancelled&)
+  catch (const Cancelled&)
   {
     bar.end();
     std::cerr << "ictk: interrupted; nothing written\n";

@@ -1,7 +1,7 @@
 # The C++ front door as a user meets it: `cmake --install` into a prefix, the prefix moved
 # elsewhere (the install must be relocatable), Examples/Pipeline configured with find_package(ICTK)
 # against it, built and run; its surface must have the triangles `ictk mesh` reports for the same
-# grid. Run by ctest: cmake -DBUILD=... -DSOURCE=... -DWORK=... -DICTK=... -P TestInstallExample.cmake
+# grid. Run by ctest: cmake -DBUILD=... -DSOURCE=... -DWORK=... -DPARAVIEW=ON|OFF -P TestInstallExample.cmake
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 function(run)
@@ -13,8 +13,12 @@ function(run)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix)
 file(RENAME ${WORK}/prefix ${WORK}/moved)
-foreach(f lib/cmake/ictk/ICTKConfig.cmake lib/cmake/ictk/ICTKConfigVersion.cmake
-    include/ictk/ictkFRepSampler.h include/ictk/FRep/Sampling.h bin/ictk bin/ictk-paraview)
+set(expected lib/cmake/ictk/ICTKConfig.cmake lib/cmake/ictk/ICTKConfigVersion.cmake
+  include/ictk/ictkFRepSampler.h include/ictk/FRep/Sampling.h bin/ictk)
+if(PARAVIEW)
+  list(APPEND expected bin/ictk-paraview lib/ictk-paraview-plugins/ICTK/ICTK.so)
+endif()
+foreach(f IN LISTS expected)
   if(NOT EXISTS ${WORK}/moved/${f})
     message(FATAL_ERROR "FAILED: the install has no ${f}")
   endif()

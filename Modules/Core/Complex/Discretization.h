@@ -7,6 +7,7 @@
 
 #include "Complex/Complex.h"
 #include "Discretize/Mesh.h"
+#include "FRep/Progress.h"
 
 #include <functional>
 
@@ -23,7 +24,7 @@ struct DiscretizationOptions
   /// 0 = TBB's default.
   int threads = 0;
   /// Called with the completed fraction; return false to cancel (throws frep::Cancelled).
-  std::function<bool(double)> progress;
+  Progress progress;
   /// discretizeComplex: only these cells (a selection, or one MPI rank's share); empty = every
   /// cell. Their meshes equal those of a whole discretisation, attributes included.
   std::vector<CellId> cells;

@@ -8,6 +8,7 @@
 // Deterministic for any thread count.
 
 #include "Discretize/Mesh.h"
+#include "FRep/Progress.h"
 
 #include <functional>
 
@@ -26,7 +27,7 @@ struct ContourOptions
   /// Refuse grids with more cells (std::invalid_argument with the estimate).
   double maxCells = 4e9;
   /// Called with the completed fraction; return false to cancel (throws frep::Cancelled).
-  std::function<bool(double)> progress;
+  Progress progress;
 };
 
 SurfaceMesh marchingTetrahedra(

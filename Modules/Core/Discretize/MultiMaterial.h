@@ -24,6 +24,7 @@
 // The output is identical for any thread count.
 
 #include "Discretize/Mesh.h"
+#include "FRep/Progress.h"
 
 #include <array>
 #include <cstdint>
@@ -41,7 +42,7 @@ struct MultiMaterialOptions
   /// 2 bytes per grid point.
   double maxCells = 2.5e8;
   /// Called with the completed fraction; return false to cancel (throws frep::Cancelled).
-  std::function<bool(double)> progress;
+  Progress progress;
 };
 
 /// A point strictly inside one connected region of one label (for region attributes and holes).

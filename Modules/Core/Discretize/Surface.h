@@ -26,6 +26,7 @@
 // thinner than a cell may be missed.
 
 #include "Discretize/Mesh.h"
+#include "FRep/Progress.h"
 
 #include <cstddef>
 #include <functional>
@@ -45,7 +46,7 @@ struct SurfaceOptions
   bool sharpFeatures = true;
   /// Called from the calling thread with the completed fraction; return false to cancel
   /// (contourSurface then throws frep::Cancelled).
-  std::function<bool(double)> progress;
+  Progress progress;
   /// Largest accepted number of grid cells (the dense count over the box, although only cells
   /// near the surface are visited): a guard against absurd resolutions.
   std::size_t maxCells = std::size_t(1) << 36;

@@ -22,6 +22,7 @@
 
 #include "Complex/Discretization.h"
 #include "Engine/DynamicModel.h"
+#include "FRep/Progress.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -48,7 +49,7 @@ struct CoherenceOptions
   /// How circular parts become explicit cells (toComplexCell).
   QueryOptions geometry;
   /// Called with the completed fraction of a frame; return false to cancel (frep::Cancelled).
-  std::function<bool(double)> progress;
+  Progress progress;
 };
 
 /// Work done for the cells of one frame, or summed over frames.

@@ -2068,7 +2068,7 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
     }
     if (m.options.progress && t > t0 &&
       !m.options.progress(std::min(1.0, (time() - t0) / (t - t0))))
-      throw RunCancelled("the run was cancelled at t = " + std::to_string(time()));
+      throw Cancelled("the run was cancelled at t = " + std::to_string(time()));
   }
   return out;
 }

@@ -15,6 +15,7 @@
 #include "Dynamics/Dependencies.h"
 #include "Engine/Interpreter.h"
 #include "Engine/Shapes.h"
+#include "FRep/Progress.h"
 #include "Lang/Icm.h"
 
 #include <functional>
@@ -37,14 +38,8 @@ struct RunOptions
   dyn::CyclePolicy cycles = dyn::CyclePolicy::PreviousState;
   /// Progress and cancellation for long runs: called after every evaluated time with the fraction
   /// done of the current advanceTo(); return false to stop (advanceTo then throws
-  /// RunCancelled, the model stays at the last evaluated time).
-  std::function<bool(double)> progress;
-};
-
-class RunCancelled : public std::runtime_error
-{
-public:
-  using std::runtime_error::runtime_error;
+  /// ictk::Cancelled, the model stays at the last evaluated time).
+  Progress progress;
 };
 
 /// One evaluated time: a requested frame or a located transition.

@@ -6,6 +6,7 @@
 
 #include "FRep/Evaluators.h"
 #include "FRep/Hypervolume.h"
+#include "FRep/Progress.h"
 
 #include <array>
 #include <atomic>
@@ -39,16 +40,6 @@ Grid gridOverBox(const std::array<double, 3>& lo, const std::array<double, 3>& h
 /// physical memory).
 void checkGrid(const Grid& grid, std::size_t bytesPerPoint, std::size_t maxBytes = 0);
 
-/// Raised when the progress callback asks to stop.
-class Cancelled : public std::runtime_error
-{
-public:
-  Cancelled()
-    : std::runtime_error("cancelled")
-  {
-  }
-};
-
 /// Counts of what a sampling did (for benchmarks: `ictk bench --scaling`).
 struct SampleStats
 {
@@ -68,7 +59,7 @@ struct SampleOptions
   /// Edge of the cubic bricks the grid is split into.
   int brickSize = 16;
   /// Called with the completed fraction; return false to cancel (sampleGrid then throws Cancelled).
-  std::function<bool(double)> progress;
+  Progress progress;
   std::vector<double> parameters;
   /// When set, receives the counts of the sampling.
   SampleStats* stats = nullptr;

@@ -7,6 +7,7 @@
 
 #include "Complex/Complex.h"
 #include "Discretize/Mesh.h"
+#include "FRep/Progress.h"
 
 #include <array>
 #include <cstdint>
@@ -55,7 +56,7 @@ struct TetraOptions
   double minDihedralDegrees = 12;
   int threads = 0;
   /// Called with the completed fraction; return false to cancel (throws frep::Cancelled).
-  std::function<bool(double)> progress;
+  Progress progress;
 };
 
 /// The number of tetrahedra a mesh of the given total volume and edge length will have, about

@@ -325,14 +325,11 @@ int ictkDynamicComplexSource::RequestData(
     this->UpdateProgress(1.0);
     return 1;
   }
-  catch (const engine::RunCancelled&)
+  catch (const ictk::Cancelled&)
   {
+    // Cancelled in the engine's run or in the meshing: start again from the model's start next
+    // time, so that no frame depends on where a cancellation fell.
     in.Interrupted = true;
-    output->Initialize();
-    return 1;
-  }
-  catch (const ictk::frep::Cancelled&)
-  {
     output->Initialize();
     return 1;
   }
