@@ -33,22 +33,6 @@ struct ictkFRepEvaluator::Internals
 
 namespace
 {
-bool Replace(char*& member, const char* value)
-{
-  if ((!value && !member) || (value && member && std::strcmp(value, member) == 0))
-  {
-    return false;
-  }
-  delete[] member;
-  member = nullptr;
-  if (value)
-  {
-    member = new char[std::strlen(value) + 1];
-    std::strcpy(member, value);
-  }
-  return true;
-}
-
 /// Points are read a block at a time into coordinate rows, whatever the array's type.
 constexpr vtkIdType Block = 4096;
 
@@ -97,6 +81,27 @@ void ReadPoints(vtkDataArray* points, vtkIdType begin, vtkIdType end, double tim
     rows[3][k] = components == 4 ? points->GetComponent(i, 3) : time;
   }
 }
+
+/// Runs body(evaluator, begin, end, rows) over blocks of the points, with one evaluator per thread
+/// (made by make(slot)) and the block's coordinates as four rows.
+template <typename Evaluator, typename Make, typename Body>
+void ForPointBlocks(
+  vtkDataArray* points, int threads, double time, const Make& make, const Body& body)
+{
+  tbb::enumerable_thread_specific<std::optional<Evaluator>> evaluators;
+  ForBlocks(points->GetNumberOfTuples(), threads,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      auto& slot = evaluators.local();
+      if (!slot)
+      {
+        make(slot);
+      }
+      std::array<std::vector<double>, 4> rows;
+      ReadPoints(points, begin, end, time, rows);
+      body(*slot, begin, end, rows);
+    });
+}
 } // namespace
 
 ictkFRepEvaluator::ictkFRepEvaluator()
@@ -112,9 +117,9 @@ ictkFRepEvaluator::~ictkFRepEvaluator()
 
 void ictkFRepEvaluator::SetModelName(const char* name)
 {
-  if (Replace(this->ModelName, name) || this->Internal->Model.Explicit || this->FileName)
+  if (ictkReplaceString(this->ModelName, name) || this->Internal->Model.Explicit || this->FileName)
   {
-    Replace(this->FileName, nullptr);
+    ictkReplaceString(this->FileName, nullptr);
     this->Internal->Model.Explicit.reset();
     this->Modified();
   }
@@ -122,8 +127,8 @@ void ictkFRepEvaluator::SetModelName(const char* name)
 
 void ictkFRepEvaluator::SetFileName(const char* name)
 {
-  Replace(this->FileName, name && *name ? name : nullptr);
-  Replace(this->ModelName, nullptr);
+  ictkReplaceString(this->FileName, name && *name ? name : nullptr);
+  ictkReplaceString(this->ModelName, nullptr);
   this->Internal->Model.Explicit.reset();
   this->Internal->Model.ReadPath.clear();
   this->Modified();
@@ -284,19 +289,13 @@ int ictkFRepEvaluator::EvaluateValues(vtkDataArray* points, vtkDataArray* values
   }
   const frep::TapePtr tape = this->Internal->Geometry;
   const std::vector<double>& parameters = this->Internal->Model.Parameters;
-  tbb::enumerable_thread_specific<std::optional<frep::BatchEvaluator<double>>> evaluators;
-  ForBlocks(points->GetNumberOfTuples(), this->NumberOfThreads,
-    [&](vtkIdType begin, vtkIdType end)
+  ForPointBlocks<frep::BatchEvaluator<double>>(
+    points, this->NumberOfThreads, this->Time, [&](auto& slot) { slot.emplace(tape, parameters); },
+    [&](auto& evaluator, vtkIdType begin, vtkIdType end,
+      const std::array<std::vector<double>, 4>& rows)
     {
-      auto& slot = evaluators.local();
-      if (!slot)
-      {
-        slot.emplace(tape, parameters);
-      }
-      std::array<std::vector<double>, 4> rows;
-      ReadPoints(points, begin, end, this->Time, rows);
       std::vector<double> out(static_cast<std::size_t>(end - begin));
-      slot->eval(
+      evaluator.eval(
         rows[0].data(), rows[1].data(), rows[2].data(), rows[3].data(), out.data(), out.size());
       for (vtkIdType i = begin; i < end; ++i)
       {
@@ -325,21 +324,16 @@ int ictkFRepEvaluator::EvaluateGradients(
   }
   const frep::TapePtr tape = this->Internal->Geometry;
   const std::vector<double>& parameters = this->Internal->Model.Parameters;
-  tbb::enumerable_thread_specific<std::optional<frep::GradientEvaluator>> evaluators;
-  ForBlocks(points->GetNumberOfTuples(), this->NumberOfThreads,
-    [&](vtkIdType begin, vtkIdType end)
+  ForPointBlocks<frep::GradientEvaluator>(
+    points, this->NumberOfThreads, this->Time, [&](auto& slot) { slot.emplace(tape, parameters); },
+    [&](auto& evaluator, vtkIdType begin, vtkIdType end,
+      const std::array<std::vector<double>, 4>& rows)
     {
-      auto& slot = evaluators.local();
-      if (!slot)
-      {
-        slot.emplace(tape, parameters);
-      }
-      std::array<std::vector<double>, 4> rows;
-      ReadPoints(points, begin, end, this->Time, rows);
       for (vtkIdType i = begin; i < end; ++i)
       {
         const auto k = static_cast<std::size_t>(i - begin);
-        const frep::ValueGradient g = slot->eval(rows[0][k], rows[1][k], rows[2][k], rows[3][k]);
+        const frep::ValueGradient g =
+          evaluator.eval(rows[0][k], rows[1][k], rows[2][k], rows[3][k]);
         for (int a = 0; a < 4; ++a)
         {
           gradients->SetComponent(i, a, g.gradient[static_cast<std::size_t>(a)]);
@@ -368,23 +362,17 @@ int ictkFRepEvaluator::EvaluateAttributes(vtkDataArray* points, vtkDataArray* at
   }
   const std::vector<double>& parameters = this->Internal->Model.Parameters;
   const std::size_t width = hv->attributeComponentCount();
-  tbb::enumerable_thread_specific<std::optional<frep::HypervolumeEvaluator>> evaluators;
-  ForBlocks(points->GetNumberOfTuples(), this->NumberOfThreads,
-    [&](vtkIdType begin, vtkIdType end)
+  ForPointBlocks<frep::HypervolumeEvaluator>(
+    points, this->NumberOfThreads, this->Time, [&](auto& slot) { slot.emplace(*hv, parameters); },
+    [&](auto& evaluator, vtkIdType begin, vtkIdType end,
+      const std::array<std::vector<double>, 4>& rows)
     {
-      auto& slot = evaluators.local();
-      if (!slot)
-      {
-        slot.emplace(*hv, parameters);
-      }
-      std::array<std::vector<double>, 4> rows;
-      ReadPoints(points, begin, end, this->Time, rows);
       std::vector<double> out(width);
       for (vtkIdType i = begin; i < end; ++i)
       {
         const auto k = static_cast<std::size_t>(i - begin);
         double value = 0;
-        slot->eval({ rows[0][k], rows[1][k], rows[2][k], rows[3][k] }, value, out.data());
+        evaluator.eval({ rows[0][k], rows[1][k], rows[2][k], rows[3][k] }, value, out.data());
         for (std::size_t c = 0; c < width; ++c)
         {
           attributes->SetComponent(i, static_cast<int>(c), out[c]);

@@ -4,6 +4,7 @@
 #include "FRep/ModelRegistry.h"
 #include "Lang/ModelFile.h"
 
+#include <cstring>
 #include <stdexcept>
 
 namespace frep = ictk::frep;
@@ -78,4 +79,20 @@ const frep::Hypervolume* ictkFRepModel::ResolveFile(const std::string& path, std
     }
     return nullptr;
   }
+}
+
+bool ictkReplaceString(char*& member, const char* value)
+{
+  if ((!value && !member) || (value && member && std::strcmp(value, member) == 0))
+  {
+    return false;
+  }
+  delete[] member;
+  member = nullptr;
+  if (value)
+  {
+    member = new char[std::strlen(value) + 1];
+    std::strcpy(member, value);
+  }
+  return true;
 }

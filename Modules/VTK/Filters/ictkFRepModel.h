@@ -37,3 +37,7 @@ struct ictkFRepModel
 private:
   const ictk::frep::Hypervolume* ResolveFile(const std::string& path, std::string& error);
 };
+
+/// Replaces a char* property of an algorithm (new[]-allocated, as vtkSetStringMacro keeps them);
+/// true when the value changed.
+bool ictkReplaceString(char*& member, const char* value);

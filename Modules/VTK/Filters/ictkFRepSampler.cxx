@@ -94,23 +94,6 @@ ictkFRepSampler::~ictkFRepSampler()
 
 namespace
 {
-/// Replaces a string property; true when it changed.
-bool ReplaceString(char*& member, const char* value)
-{
-  if ((!value && !member) || (value && member && std::strcmp(value, member) == 0))
-  {
-    return false;
-  }
-  delete[] member;
-  member = nullptr;
-  if (value)
-  {
-    member = new char[std::strlen(value) + 1];
-    std::strcpy(member, value);
-  }
-  return true;
-}
-
 std::string LowerExtension(const std::string& path)
 {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -124,14 +107,14 @@ std::string LowerExtension(const std::string& path)
 
 void ictkFRepSampler::SetFileName(const char* name)
 {
-  const bool changed = ReplaceString(this->FileName, name && *name ? name : nullptr);
+  const bool changed = ictkReplaceString(this->FileName, name && *name ? name : nullptr);
   if (!changed && !this->Internal->Model.Explicit)
   {
     return;
   }
   if (this->FileName)
   {
-    ReplaceString(this->ModelName, nullptr);
+    ictkReplaceString(this->ModelName, nullptr);
   }
   this->Internal->Model.Explicit.reset();
   this->Internal->Model.ReadPath.clear(); // read again, even a file of the same name
@@ -173,14 +156,14 @@ int ictkFRepSampler::CanReadFile(const char* name)
 
 void ictkFRepSampler::SetModelName(const char* name)
 {
-  const bool changed = ReplaceString(this->ModelName, name);
+  const bool changed = ictkReplaceString(this->ModelName, name);
   if (!changed && !this->Internal->Model.Explicit && !(name && this->FileName))
   {
     return;
   }
   if (name)
   {
-    ReplaceString(this->FileName, nullptr);
+    ictkReplaceString(this->FileName, nullptr);
   }
   this->Internal->Model.Explicit.reset();
   this->Modified();
