@@ -383,6 +383,8 @@ struct ictkComplexSource::Internals
   std::filesystem::file_time_type ReadTime{};
   std::shared_ptr<const complex::Complex> Read;
   vtkSmartPointer<vtkDataAssembly> Assembly;
+  /// The complex Assembly was built from.
+  std::shared_ptr<const complex::Complex> AssemblyOf;
 };
 
 ictkComplexSource::ictkComplexSource()
@@ -633,6 +635,7 @@ int ictkComplexSource::RequestInformation(
   {
     const auto k = LoadComplex();
     this->Internal->Assembly = MakeAssembly(*k, k->cellIds());
+    this->Internal->AssemblyOf = k;
     ++this->AssemblyTag;
   }
   catch (const std::exception& e)
@@ -659,7 +662,9 @@ int ictkComplexSource::RequestData(
       std::vector<complex::CellId> chosen = all;
       if (!this->Selectors.empty())
       {
-        const vtkSmartPointer<vtkDataAssembly> assembly = MakeAssembly(*k, all);
+        // RequestInformation built the assembly of this complex (all cells, in order).
+        const vtkSmartPointer<vtkDataAssembly> assembly =
+          this->Internal->AssemblyOf == k ? this->Internal->Assembly : MakeAssembly(*k, all);
         const std::vector<int> nodes = assembly->SelectNodes(this->Selectors);
         std::vector<unsigned int> indices = assembly->GetDataSetIndices(nodes, true);
         std::sort(indices.begin(), indices.end());

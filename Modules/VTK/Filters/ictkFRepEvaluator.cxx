@@ -117,21 +117,18 @@ ictkFRepEvaluator::~ictkFRepEvaluator()
 
 void ictkFRepEvaluator::SetModelName(const char* name)
 {
-  if (ictkReplaceString(this->ModelName, name) || this->Internal->Model.Explicit || this->FileName)
+  if (this->Internal->Model.SelectModelName(this->ModelName, this->FileName, name))
   {
-    ictkReplaceString(this->FileName, nullptr);
-    this->Internal->Model.Explicit.reset();
     this->Modified();
   }
 }
 
 void ictkFRepEvaluator::SetFileName(const char* name)
 {
-  ictkReplaceString(this->FileName, name && *name ? name : nullptr);
-  ictkReplaceString(this->ModelName, nullptr);
-  this->Internal->Model.Explicit.reset();
-  this->Internal->Model.ReadPath.clear();
-  this->Modified();
+  if (this->Internal->Model.SelectFileName(this->ModelName, this->FileName, name))
+  {
+    this->Modified();
+  }
 }
 
 void ictkFRepEvaluator::SetHypervolume(const frep::Hypervolume& hv)

@@ -81,6 +81,37 @@ const frep::Hypervolume* ictkFRepModel::ResolveFile(const std::string& path, std
   }
 }
 
+bool ictkFRepModel::SelectModelName(char*& modelName, char*& fileName, const char* name)
+{
+  const bool changed = ictkReplaceString(modelName, name);
+  if (!changed && !this->Explicit && !(name && fileName))
+  {
+    return false;
+  }
+  if (name)
+  {
+    ictkReplaceString(fileName, nullptr);
+  }
+  this->Explicit.reset();
+  return true;
+}
+
+bool ictkFRepModel::SelectFileName(char*& modelName, char*& fileName, const char* name)
+{
+  const bool changed = ictkReplaceString(fileName, name && *name ? name : nullptr);
+  if (!changed && !this->Explicit)
+  {
+    return false;
+  }
+  if (fileName)
+  {
+    ictkReplaceString(modelName, nullptr);
+  }
+  this->Explicit.reset();
+  this->ReadPath.clear();
+  return true;
+}
+
 bool ictkReplaceString(char*& member, const char* value)
 {
   if ((!value && !member) || (value && member && std::strcmp(value, member) == 0))

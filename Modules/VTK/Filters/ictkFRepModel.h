@@ -34,6 +34,13 @@ struct ictkFRepModel
   const ictk::frep::Hypervolume* Resolve(
     const char* modelName, const char* fileName, std::string& error);
 
+  /// The name and file setters of the algorithms that own modelName and fileName (char*
+  /// properties): setting one clears the other and a hypervolume; true when the algorithm
+  /// changed (call Modified()). A file whose name did not change is read again only when it
+  /// changed on disk (Resolve compares its time).
+  bool SelectModelName(char*& modelName, char*& fileName, const char* name);
+  bool SelectFileName(char*& modelName, char*& fileName, const char* name);
+
 private:
   const ictk::frep::Hypervolume* ResolveFile(const std::string& path, std::string& error);
 };

@@ -6,7 +6,6 @@
 #include "FRep/Hypervolume.h"
 #include "FRep/ModelRegistry.h"
 #include "FRep/Sampling.h"
-#include "Lang/Diagnostics.h"
 #include "Lang/ModelFile.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -107,18 +106,10 @@ std::string LowerExtension(const std::string& path)
 
 void ictkFRepSampler::SetFileName(const char* name)
 {
-  const bool changed = ictkReplaceString(this->FileName, name && *name ? name : nullptr);
-  if (!changed && !this->Internal->Model.Explicit)
+  if (this->Internal->Model.SelectFileName(this->ModelName, this->FileName, name))
   {
-    return;
+    this->Modified();
   }
-  if (this->FileName)
-  {
-    ictkReplaceString(this->ModelName, nullptr);
-  }
-  this->Internal->Model.Explicit.reset();
-  this->Internal->Model.ReadPath.clear(); // read again, even a file of the same name
-  this->Modified();
 }
 
 int ictkFRepSampler::CanReadFile(const char* name)
@@ -156,17 +147,10 @@ int ictkFRepSampler::CanReadFile(const char* name)
 
 void ictkFRepSampler::SetModelName(const char* name)
 {
-  const bool changed = ictkReplaceString(this->ModelName, name);
-  if (!changed && !this->Internal->Model.Explicit && !(name && this->FileName))
+  if (this->Internal->Model.SelectModelName(this->ModelName, this->FileName, name))
   {
-    return;
+    this->Modified();
   }
-  if (name)
-  {
-    ictkReplaceString(this->FileName, nullptr);
-  }
-  this->Internal->Model.Explicit.reset();
-  this->Modified();
 }
 
 void ictkFRepSampler::SetHypervolume(const frep::Hypervolume& hv)
