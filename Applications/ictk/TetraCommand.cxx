@@ -7,6 +7,7 @@
 #include "Mesh/Attributes.h"
 #include "Mesh/Backends/Backends.h"
 #include "Mesh/Quality.h"
+#include "Mesh/Validity.h"
 #include "Mesh/Writers.h"
 #include "ictkTetrahedralize.h"
 
@@ -130,7 +131,8 @@ int RunTetra(const TetraOptions& o)
     }
     return true;
   };
-  mesh::TetMesh m = mesh::tetrahedralize(k, *chosen, options);
+  mesh::ValidityReport validity;
+  mesh::TetMesh m = mesh::tetrahedralize(k, *chosen, options, &validity);
   if (terminal)
   {
     std::fprintf(stderr, "\n");
@@ -167,6 +169,14 @@ int RunTetra(const TetraOptions& o)
     j["min_dihedral_degrees"] = q.minDihedralDegrees;
     j["min_dihedral_percentile1_degrees"] = q.minDihedralPercentile1Degrees;
     j["max_radius_edge_ratio"] = q.maxRadiusEdgeRatio;
+    j["validity"] = { { "valid", validity.valid() }, { "min_edge", validity.minEdge },
+      { "min_edge_relative", validity.minEdgeRelative }, { "min_volume", validity.minVolume },
+      { "min_volume_relative", validity.minVolumeRelative },
+      { "non_positive", validity.nonPositive }, { "duplicate_points", validity.duplicatePoints },
+      { "interior_faces", validity.interiorFaces }, { "boundary_faces", validity.boundaryFaces },
+      { "non_conforming_faces", validity.nonConformingFaces },
+      { "stray_boundary_faces", validity.strayBoundaryFaces },
+      { "unchecked_boundary_faces", validity.uncheckedBoundaryFaces } };
     j["materials"] = nlohmann::json::array();
     for (const auto& v : volumes)
     {
@@ -179,7 +189,8 @@ int RunTetra(const TetraOptions& o)
   }
   std::cout << "wrote " << o.Output << " (" << q.tetrahedra << " tetrahedra, " << backend
             << ", size " << options.size << ") in " << meshSeconds << " s\n"
-            << mesh::formatQualityReport(q) << mesh::formatVolumeComparison(volumes);
+            << mesh::formatQualityReport(q) << mesh::formatValidityReport(validity)
+            << mesh::formatVolumeComparison(volumes);
   return 0;
 }
 

@@ -17,10 +17,11 @@
 namespace ictk::testing
 {
 
-/// The solver check's bar: E = 210000 | 70000, nu = 0 (springs in series are then exact).
+/// The solver check's bar: E = 210000 | 70000, nu = 0 (springs in series are then exact) unless
+/// `poisson` says otherwise.
 inline std::string barJson(const std::string& left = "steel",
   const std::string& right = "aluminium", const std::string& leftModulus = "210000",
-  bool spare = false)
+  bool spare = false, const std::string& poisson = "0")
 {
   std::string s = R"({ "name": "bar",
   "attributes": {
@@ -30,7 +31,7 @@ inline std::string barJson(const std::string& left = "steel",
   },
   "attribute_functions": {
     "E1": [")" +
-    leftModulus + R"("], "E2": ["70000"], "NU": ["0"], "RHO": ["7.8e-9"]
+    leftModulus + R"("], "E2": ["70000"], "NU": [")" + poisson + R"("], "RHO": ["7.8e-9"]
   },
   "cells": [
     { "name": ")" +

@@ -4,8 +4,8 @@
 Python API) and checks counts, labels and volumes per material against the writer's manifest.
 
 Usage: mesh_files_check.py --writer PATH --work DIR
-Exit 77 (ctest: skipped) when meshio or gmsh is not installed (Scripts/setup installs
-python3-meshio and python3-gmsh).
+Fails when meshio or gmsh is not installed: Scripts/setup installs python3-meshio and
+python3-gmsh, so a missing reader is a broken install.
 """
 import argparse
 import os
@@ -18,8 +18,7 @@ try:
     import meshio
     import gmsh
 except ImportError as e:
-    print(f"SKIP: {e} (install python3-meshio and python3-gmsh: Scripts/setup)")
-    sys.exit(77)
+    sys.exit(f"FAIL: {e} (install python3-meshio and python3-gmsh: Scripts/setup)")
 
 
 def fail(message):

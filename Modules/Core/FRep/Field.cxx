@@ -108,6 +108,16 @@ public:
   {
     return std::make_unique<TapeFieldEvaluator>(tape_, time_, parameters_);
   }
+  std::optional<FieldSplit> split() const override
+  {
+    const auto s = tape_->split();
+    if (!s)
+    {
+      return std::nullopt;
+    }
+    return FieldSplit{ s->op == Opcode::Min, std::make_shared<TapeField>(s->a, time_, parameters_),
+      std::make_shared<TapeField>(s->b, time_, parameters_) };
+  }
 
 private:
   TapePtr tape_;
@@ -288,6 +298,29 @@ public:
     auto e = std::make_unique<CombinedFieldEvaluator>(op_, std::move(parts));
     e->setSources(fields_);
     return e;
+  }
+  std::optional<FieldSplit> split() const override
+  {
+    using Op = CombinedFieldEvaluator::Op;
+    if (op_ == Op::Negate)
+    {
+      // -min(a, b) = max(-a, -b) and -max(a, b) = min(-a, -b).
+      auto s = fields_[0]->split();
+      if (!s)
+      {
+        return std::nullopt;
+      }
+      return FieldSplit{ !s->minimum, negatedField(s->a), negatedField(s->b) };
+    }
+    if (fields_.size() == 1)
+    {
+      return fields_[0]->split();
+    }
+    FieldPtr rest = fields_.size() == 2
+      ? fields_[1]
+      : std::make_shared<CombinedField>(
+          op_, std::vector<FieldPtr>(fields_.begin() + 1, fields_.end()));
+    return FieldSplit{ op_ == Op::Min, fields_[0], std::move(rest) };
   }
 
 private:

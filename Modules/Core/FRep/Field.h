@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace ictk::frep
@@ -59,13 +60,27 @@ public:
   }
 };
 
+class Field;
+using FieldPtr = std::shared_ptr<const Field>;
+
+/// A field that is the min or max of two fields: the intersection or union of their solids.
+struct FieldSplit
+{
+  /// true: min (intersection); false: max (union).
+  bool minimum = true;
+  FieldPtr a;
+  FieldPtr b;
+};
+
 class Field
 {
 public:
   virtual ~Field() = default;
   virtual std::unique_ptr<FieldEvaluator> evaluator() const = 0;
+  /// The min or max at the root of this field, when it is one: the solid's sharp edges lie where
+  /// two of the operands vanish, which no sampling of the field itself pins down.
+  virtual std::optional<FieldSplit> split() const { return std::nullopt; }
 };
-using FieldPtr = std::shared_ptr<const Field>;
 
 /// The field of a tape's first output at time `time` (x, y, z vary; t fixed) with the given
 /// parameter values. The evaluators prune the tape by interval arithmetic in narrowed().

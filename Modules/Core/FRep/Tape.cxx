@@ -262,9 +262,36 @@ TapePtr Tape::simplify(const std::vector<Choice>& choices) const
   {
     return shared_from_this();
   }
+  return extract(alias, outputValues_);
+}
+
+std::optional<Tape::Split> Tape::split() const
+{
+  const std::uint32_t leafCount = temporaryBase();
+  if (outputValues_.empty() || outputValues_[0] < leafCount)
+  {
+    return std::nullopt;
+  }
+  const TapeSsa& s = ssa_[outputValues_[0] - leafCount];
+  if (s.op != Opcode::Min && s.op != Opcode::Max)
+  {
+    return std::nullopt;
+  }
+  std::vector<std::uint32_t> identity(leafCount + ssa_.size());
+  for (std::uint32_t v = 0; v < identity.size(); ++v)
+  {
+    identity[v] = v;
+  }
+  return Split{ s.op, extract(identity, { s.a }), extract(identity, { s.b }) };
+}
+
+TapePtr Tape::extract(
+  const std::vector<std::uint32_t>& alias, const std::vector<std::uint32_t>& outputValues) const
+{
+  const std::uint32_t leafCount = temporaryBase();
   // Backward pass: keep only instructions some output still reaches.
   std::vector<bool> live(leafCount + ssa_.size(), false);
-  for (std::uint32_t v : outputValues_)
+  for (std::uint32_t v : outputValues)
   {
     live[alias[v]] = true;
   }
@@ -314,7 +341,7 @@ TapePtr Tape::simplify(const std::vector<Choice>& choices) const
     kept.push_back(s);
   }
   std::vector<std::uint32_t> outputs;
-  for (std::uint32_t v : outputValues_)
+  for (std::uint32_t v : outputValues)
   {
     outputs.push_back(renumber[alias[v]]);
   }

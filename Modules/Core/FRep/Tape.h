@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -96,11 +97,26 @@ public:
   /// instruction, as filled by IntervalEvaluator). Returns this tape's twin when nothing is cut.
   std::shared_ptr<const Tape> simplify(const std::vector<Choice>& choices) const;
 
+  /// A min or max at the root of the first output: an intersection or union of two solids, whose
+  /// boundaries meet in sharp edges. The operator and a tape for each operand (parameters
+  /// numbered as here); nullopt when the output is computed otherwise.
+  struct Split
+  {
+    Opcode op;
+    std::shared_ptr<const Tape> a;
+    std::shared_ptr<const Tape> b;
+  };
+  std::optional<Split> split() const;
+
   /// Splits the tape for rows along which only `varyingAxes` (a mask of axes) change.
   RowProgram rowProgram(std::uint8_t varyingAxes) const;
 
 private:
   Tape() = default;
+  /// The tape of `outputValues` with every value v read as alias[v], without the instructions
+  /// no output reaches.
+  std::shared_ptr<const Tape> extract(
+    const std::vector<std::uint32_t>& alias, const std::vector<std::uint32_t>& outputValues) const;
   static std::shared_ptr<const Tape> build(std::uint32_t parameterCount,
     std::vector<double> constants, std::vector<TapeSsa> ssa,
     std::vector<std::uint32_t> outputValues);

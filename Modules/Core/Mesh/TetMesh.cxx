@@ -16,7 +16,7 @@ double estimateTetrahedra(double volume, double size)
   return volume / (size * size * size / (6 * std::sqrt(2.0)));
 }
 
-void validate(const TetMesh& mesh)
+void validateStructure(const TetMesh& mesh)
 {
   const auto n = mesh.tetrahedra.size();
   if (mesh.cells.size() != n || mesh.materials.size() != n)
@@ -44,6 +44,22 @@ void validate(const TetMesh& mesh)
           " uses point " + std::to_string(i) + " of " + std::to_string(mesh.points.size()));
       }
     }
+    if (mesh.materials[t] < 1 ||
+      static_cast<std::size_t>(mesh.materials[t]) > mesh.materialNames.size())
+    {
+      throw std::invalid_argument("tetrahedral mesh: tetrahedron " + std::to_string(t) +
+        " has material " + std::to_string(mesh.materials[t]) + " of " +
+        std::to_string(mesh.materialNames.size()));
+    }
+  }
+}
+
+void validate(const TetMesh& mesh)
+{
+  validateStructure(mesh);
+  for (std::size_t t = 0; t < mesh.tetrahedra.size(); ++t)
+  {
+    const auto& tet = mesh.tetrahedra[t];
     const Point3& a = mesh.points[tet[0]];
     double e[3][3];
     for (int k = 0; k < 3; ++k)
@@ -60,13 +76,6 @@ void validate(const TetMesh& mesh)
     {
       throw std::invalid_argument("tetrahedral mesh: tetrahedron " + std::to_string(t) +
         " is not positively oriented (6 x volume = " + std::to_string(volume) + ")");
-    }
-    if (mesh.materials[t] < 1 ||
-      static_cast<std::size_t>(mesh.materials[t]) > mesh.materialNames.size())
-    {
-      throw std::invalid_argument("tetrahedral mesh: tetrahedron " + std::to_string(t) +
-        " has material " + std::to_string(mesh.materials[t]) + " of " +
-        std::to_string(mesh.materialNames.size()));
     }
   }
 }

@@ -41,6 +41,9 @@ struct TetMesh
   std::vector<std::string> materialNames;
   /// Attribute values per tetrahedron (sampled at centroids).
   std::vector<TetArray> cellData;
+  /// The element size it was made for (TetraOptions::size); 0 when unknown. The validity check's
+  /// limits are relative to it.
+  double size = 0;
 };
 
 /// Options shared by the backends.
@@ -63,8 +66,11 @@ struct TetraOptions
 /// (regular tetrahedra of edge `size`, volume size^3 / (6 sqrt 2)).
 double estimateTetrahedra(double volume, double size);
 
-/// Checks indices, orientation (positive volume) and the per-tetrahedron arrays; throws
-/// std::invalid_argument naming the first problem.
+/// Checks indices, materials and the per-tetrahedron arrays; throws std::invalid_argument naming
+/// the first problem.
+void validateStructure(const TetMesh& mesh);
+/// validateStructure, and every tetrahedron positively oriented. What a solver needs beyond that
+/// is checkValidity's (Validity.h).
 void validate(const TetMesh& mesh);
 
 } // namespace ictk::mesh

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Mesh/Writers.h"
 
+#include "Mesh/Validity.h"
+
 #include "Mesh/Attributes.h"
 #include "Mesh/Quality.h"
 
@@ -106,17 +108,18 @@ void writeAtomically(const std::string& path, const std::function<void(Out&)>& b
 
 void checkWritable(const TetMesh& mesh, const std::string& path)
 {
+  if (mesh.tetrahedra.empty())
+  {
+    throw std::invalid_argument("cannot write '" + path + "': the mesh has no tetrahedra");
+  }
+  // Everything but the boundary check, which needs the complex (the backends run that).
   try
   {
-    validate(mesh);
+    requireValid(checkValidity(mesh, mesh.size), "the mesh");
   }
   catch (const std::invalid_argument& e)
   {
     throw std::invalid_argument("cannot write '" + path + "': " + e.what());
-  }
-  if (mesh.tetrahedra.empty())
-  {
-    throw std::invalid_argument("cannot write '" + path + "': the mesh has no tetrahedra");
   }
 }
 

@@ -140,6 +140,18 @@ void ictkTetrahedralize::AddQualityFields(const ictk::mesh::QualityReport& repor
   fd->AddArray(angle);
 }
 
+void ictkTetrahedralize::AddValidityFields(
+  const ictk::mesh::ValidityReport& report, vtkFieldData* fd)
+{
+  AddNumber(fd, "MinEdgeLength", report.minEdge);
+  AddNumber(fd, "MinEdgeLengthRelative", report.minEdgeRelative);
+  AddNumber(fd, "MinTetrahedronVolume", report.minVolume);
+  AddNumber(fd, "MinTetrahedronVolumeRelative", report.minVolumeRelative);
+  AddNumber(fd, "DuplicatePoints", static_cast<double>(report.duplicatePoints));
+  AddNumber(fd, "NonConformingFaces", static_cast<double>(report.nonConformingFaces));
+  AddNumber(fd, "StrayBoundaryFaces", static_cast<double>(report.strayBoundaryFaces));
+}
+
 int ictkTetrahedralize::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -166,10 +178,12 @@ int ictkTetrahedralize::RequestData(
   return ictk::vtk::runRequest(this, output,
     [&]
     {
+      ictk::mesh::ValidityReport validity;
       const ictk::mesh::TetMesh mesh =
-        ictk::mesh::tetrahedralize(*complex, BackendOf(this->Backend), options);
+        ictk::mesh::tetrahedralize(*complex, BackendOf(this->Backend), options, &validity);
       Convert(mesh, output);
       AddQualityFields(ictk::mesh::measureQuality(mesh), output->GetFieldData());
+      AddValidityFields(validity, output->GetFieldData());
       return 1;
     });
 }

@@ -34,6 +34,7 @@ namespace mesh
 {
 struct TetMesh;
 struct QualityReport;
+struct ValidityReport;
 } // namespace mesh
 } // namespace ictk
 #endif
@@ -77,6 +78,9 @@ public:
   static void Convert(const ictk::mesh::TetMesh& mesh, vtkUnstructuredGrid* output);
   /// The quality report as one-value field arrays (names in the class comment).
   static void AddQualityFields(const ictk::mesh::QualityReport& report, vtkFieldData* fd);
+  /// The validity check's figures (ictk::mesh::checkValidity): MinEdgeLength(Relative),
+  /// MinTetrahedronVolume(Relative), DuplicatePoints, NonConformingFaces, StrayBoundaryFaces.
+  static void AddValidityFields(const ictk::mesh::ValidityReport& report, vtkFieldData* fd);
 #endif
 
 protected:

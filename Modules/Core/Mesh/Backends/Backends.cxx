@@ -60,8 +60,9 @@ std::optional<Backend> defaultBackend()
   return built.empty() ? std::nullopt : std::optional<Backend>(built.front());
 }
 
-TetMesh tetrahedralize(
-  const complex::Complex& complex, Backend backend, const TetraOptions& options)
+namespace
+{
+TetMesh run(const complex::Complex& complex, Backend backend, const TetraOptions& options)
 {
 #ifdef ICTK_HAVE_MESH_CGAL
   if (backend == Backend::Cgal)
@@ -79,6 +80,21 @@ TetMesh tetrahedralize(
   (void)options;
   throw std::invalid_argument(std::string("the ") + backendName(backend) +
     " backend was not built (configure with ICTK_ENABLE_GPL_BACKENDS=ON and its library)");
+}
+} // namespace
+
+TetMesh tetrahedralize(const complex::Complex& complex, Backend backend,
+  const TetraOptions& options, ValidityReport* validity)
+{
+  TetMesh mesh = run(complex, backend, options);
+  mesh.size = options.size;
+  const ValidityReport report = checkValidity(mesh, options.size, &complex);
+  requireValid(report, std::string("the ") + backendName(backend) + " backend's mesh");
+  if (validity)
+  {
+    *validity = report;
+  }
+  return mesh;
 }
 
 } // namespace ictk::mesh

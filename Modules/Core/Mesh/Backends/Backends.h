@@ -6,6 +6,7 @@
 
 #include "Complex/Complex.h"
 #include "Mesh/TetMesh.h"
+#include "Mesh/Validity.h"
 
 #include <optional>
 #include <string>
@@ -31,9 +32,11 @@ bool hasBackend(Backend backend);
 /// The first of availableBackends(); nullopt when none was built.
 std::optional<Backend> defaultBackend();
 
-/// Meshes the complex with the backend; throws std::invalid_argument when it was not built
-/// (saying how to build it), and whatever the backend throws.
-TetMesh tetrahedralize(
-  const complex::Complex& complex, Backend backend, const TetraOptions& options);
+/// Meshes the complex with the backend and checks the mesh (checkValidity with the complex, into
+/// `validity` when given). Throws std::invalid_argument when the backend was not built (saying
+/// how to build it) or its mesh is not valid (saying what failed and where), and whatever the
+/// backend throws.
+TetMesh tetrahedralize(const complex::Complex& complex, Backend backend,
+  const TetraOptions& options, ValidityReport* validity = nullptr);
 
 } // namespace ictk::mesh

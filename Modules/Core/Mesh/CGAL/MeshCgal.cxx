@@ -642,6 +642,113 @@ std::vector<Patch> collectPatches(const Complex& complex, const std::vector<Soli
 
 // --- feature curves ---------------------------------------------------------------------------
 
+/// A solid's boundary as smooth faces: the leaves of the min/max tree of its inside fields (their
+/// common min is the root). A leaf's zero set is on the boundary where every sibling along its
+/// path to the root allows it: a min's other operands >= 0, a max's <= 0. Two faces meet in a sharp
+/// edge; tracing the curve where both vanish, under their paths' conditions, finds it exactly,
+/// which no sampling of the solid's field does (issue 21: the CGAL boxes lost 0.7 % of their
+/// volume at rounded edges).
+struct SolidFaces
+{
+  struct Node
+  {
+    bool minimum = true;
+    std::vector<FieldPtr> branches;
+  };
+  struct Face
+  {
+    FieldPtr field;
+    /// (node, branch) from the root down.
+    std::vector<std::pair<std::size_t, std::size_t>> path;
+  };
+  std::vector<Node> nodes;
+  std::vector<Face> faces;
+
+  /// The conditions of a face's path: where they hold, the face is on the solid's boundary.
+  std::vector<FieldPtr> faceTrims(std::size_t face) const { return trims(faces[face].path, 0, {}); }
+
+  /// The conditions under which faces k and m meet on the boundary: both paths' conditions, but
+  /// not, at the node where the paths part, each branch's condition on the other (it vanishes
+  /// along the whole crease).
+  std::vector<FieldPtr> creaseTrims(std::size_t k, std::size_t m) const
+  {
+    const auto& a = faces[k].path;
+    const auto& b = faces[m].path;
+    std::size_t d = 0;
+    while (d < a.size() && d < b.size() && a[d] == b[d])
+    {
+      ++d;
+    }
+    // Above the parting node the paths agree: their conditions once.
+    std::vector<FieldPtr> out = trims(std::vector(a.begin(), a.begin() + std::ptrdiff_t(d)), 0, {});
+    if (d < a.size() && d < b.size())
+    {
+      const auto t = trims({ a[d] }, 0, b[d].second);
+      out.insert(out.end(), t.begin(), t.end());
+    }
+    for (const auto* path : { &a, &b })
+    {
+      const auto t = trims(*path, d + 1, {});
+      out.insert(out.end(), t.begin(), t.end());
+    }
+    return out;
+  }
+
+private:
+  std::vector<FieldPtr> trims(const std::vector<std::pair<std::size_t, std::size_t>>& path,
+    std::size_t from, std::optional<std::size_t> alsoSkip) const
+  {
+    std::vector<FieldPtr> out;
+    for (std::size_t e = from; e < path.size(); ++e)
+    {
+      const Node& n = nodes[path[e].first];
+      for (std::size_t j = 0; j < n.branches.size(); ++j)
+      {
+        if (j != path[e].second && (e != from || j != alsoSkip))
+        {
+          out.push_back(n.minimum ? n.branches[j] : frep::negatedField(n.branches[j]));
+        }
+      }
+    }
+    return out;
+  }
+};
+
+/// At most this many faces per solid: every pair is traced.
+constexpr std::size_t kMaxFaces = 16;
+
+SolidFaces solidFaces(const Solid& s)
+{
+  SolidFaces out;
+  out.nodes.push_back({ true, s.inside });
+  // Breadth first, so that a deep tree is cut evenly at kMaxFaces.
+  std::vector<SolidFaces::Face> pending;
+  for (std::size_t i = 0; i < s.inside.size(); ++i)
+  {
+    pending.push_back({ s.inside[i], { { 0, i } } });
+  }
+  for (std::size_t next = 0; next < pending.size(); ++next)
+  {
+    SolidFaces::Face f = pending[next];
+    const std::size_t open = pending.size() - next - 1;
+    const auto split = out.faces.size() + open + 2 <= kMaxFaces ? f.field->split() : std::nullopt;
+    if (!split)
+    {
+      out.faces.push_back(std::move(f));
+      continue;
+    }
+    const std::size_t node = out.nodes.size();
+    out.nodes.push_back({ split->minimum, { split->a, split->b } });
+    for (std::size_t j = 0; j < 2; ++j)
+    {
+      auto path = f.path;
+      path.emplace_back(node, j);
+      pending.push_back({ j == 0 ? split->a : split->b, std::move(path) });
+    }
+  }
+  return out;
+}
+
 void appendCurves(const discretize::CurveSet& curves, std::vector<Polyline>& out)
 {
   for (const auto& line : curves.lines)
@@ -896,23 +1003,18 @@ std::vector<Polyline> featureCurves(const Complex& complex, const std::vector<So
       }
     }
   }
-  // Creases of each solid: where two of its inside fields vanish.
+  // Creases of each solid: where two of its faces meet.
+  std::vector<SolidFaces> faces;
   for (const Solid& s : solids)
   {
-    for (std::size_t k = 0; k < s.inside.size(); ++k)
+    faces.push_back(solidFaces(s));
+    const SolidFaces& f = faces.back();
+    for (std::size_t k = 0; k < f.faces.size(); ++k)
     {
-      for (std::size_t m = k + 1; m < s.inside.size(); ++m)
+      for (std::size_t m = k + 1; m < f.faces.size(); ++m)
       {
-        std::vector<FieldPtr> trims;
-        for (std::size_t r = 0; r < s.inside.size(); ++r)
-        {
-          if (r != k && r != m)
-          {
-            trims.push_back(s.inside[r]);
-          }
-        }
-        traceFeature(
-          s.inside[k], s.inside[m], trims, padded(s.box, pad), step, options.threads, candidates);
+        traceFeature(f.faces[k].field, f.faces[m].field, f.creaseTrims(k, m), padded(s.box, pad),
+          step, options.threads, candidates);
       }
     }
   }
@@ -933,27 +1035,15 @@ std::vector<Polyline> featureCurves(const Complex& complex, const std::vector<So
       {
         continue;
       }
-      for (std::size_t k = 0; k < a.inside.size(); ++k)
+      for (std::size_t k = 0; k < faces[i].faces.size(); ++k)
       {
-        for (std::size_t m = 0; m < b.inside.size(); ++m)
+        for (std::size_t m = 0; m < faces[j].faces.size(); ++m)
         {
-          std::vector<FieldPtr> trims;
-          for (std::size_t r = 0; r < a.inside.size(); ++r)
-          {
-            if (r != k)
-            {
-              trims.push_back(a.inside[r]);
-            }
-          }
-          for (std::size_t r = 0; r < b.inside.size(); ++r)
-          {
-            if (r != m)
-            {
-              trims.push_back(b.inside[r]);
-            }
-          }
-          traceFeature(
-            a.inside[k], b.inside[m], trims, padded(o, pad), step, options.threads, candidates);
+          std::vector<FieldPtr> trims = faces[i].faceTrims(k);
+          const std::vector<FieldPtr> other = faces[j].faceTrims(m);
+          trims.insert(trims.end(), other.begin(), other.end());
+          traceFeature(faces[i].faces[k].field, faces[j].faces[m].field, trims, padded(o, pad),
+            step, options.threads, candidates);
         }
       }
     }
@@ -1058,6 +1148,7 @@ void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& so
   auto cwp = c3t3.triangulation().geom_traits().construct_weighted_point_3_object();
   const auto intersects = domain.do_intersect_surface_object();
   const auto intersection = domain.construct_intersection_object();
+  std::vector<Point3> seeds;
   for (std::size_t i = 0; i < solids.size(); ++i)
   {
     const Box3& b = solids[i].box;
@@ -1110,7 +1201,12 @@ void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& so
           const Point3 point{ q.x(), q.y(), q.z() };
           const bool nearCurve = std::any_of(features.begin(), features.end(),
             [&](const Polyline& f) { return distanceToPolyline(point, f) < 0.5 * size; });
-          if (nearCurve)
+          // Two solids sharing a face find the same interface point from either side, up to
+          // the bisection's error: both inserted, they left clusters of vertices 1e-8 apart that
+          // refinement never removes (issue 21's micro-tetrahedra).
+          const bool nearSeed = std::any_of(seeds.begin(), seeds.end(),
+            [&](const Point3& s) { return dist(point, s) < 0.5 * size; });
+          if (nearCurve || nearSeed)
           {
             continue;
           }
@@ -1119,6 +1215,7 @@ void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& so
           {
             c3t3.set_dimension(v, 2);
             c3t3.set_index(v, domain.index_from_surface_patch_index(*surface));
+            seeds.push_back(point);
           }
         }
       }
@@ -1224,12 +1321,15 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
     p::facet_distance = 0.1 * h, p::cell_radius_edge_ratio = 3, p::cell_size = kCellRadius * h);
 
   labeller->setPhase(0.1);
-  // make_mesh_3's steps, with initial surface points on every solid: CGAL shoots random rays from
-  // the box's centre only when the protected curves give no surface facet, and so misses solids
-  // away from the curves (the flower's stamen).
+  // make_mesh_3's steps, with initial surface points on every solid. make_mesh_3's own seeding
+  // (random rays from the centre of the box, and only when the protected curves give no surface
+  // facet) is not used: it misses solids away from the curves (the flower's stamen), and a centre
+  // on an interface (the two-material bar's) put dozens of points within 1e-8 of each other there.
   C3t3 c3t3;
-  CGAL::Mesh_3::internal::C3t3_initializer<C3t3, Domain, Criteria, true>()(
-    c3t3, domain, criteria, true);
+  if (!features.empty())
+  {
+    CGAL::Mesh_3::internal::init_c3t3_with_features(c3t3, domain, criteria);
+  }
   seedSurfaces(c3t3, domain, solids, *labeller, features, outer, h);
   CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::no_reset_c3t3());
   report(options, 0.6);
