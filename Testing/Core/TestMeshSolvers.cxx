@@ -86,6 +86,32 @@ TEST_P(MeshSolvers, BarOfDataKeepsItsEdgesAndVolume)
   }
 }
 
+TEST_P(MeshSolvers, FourMaterialBarKeepsItsBlocks)
+{
+  // Issue 21 saw the micro-tetrahedra on every interface of a bar of more materials: four unit
+  // blocks along x, each one min() field, volume 0.04 each.
+  std::string json = R"({ "name": "bar4", "cells": [)";
+  for (int i = 0; i < 4; ++i)
+  {
+    const std::string lo = std::to_string(i), hi = std::to_string(i + 1);
+    json += std::string(i ? "," : "") + R"({ "name": "m)" + lo +
+      R"(", "kind": "F", "dimension": 3, "inside": ["min(min(min(x[1] - )" + lo + ", " + hi +
+      R"j( - x[1]), min(x[2], 0.2 - x[2])), min(x[3], 0.2 - x[3]))"], "bounds": [[)j" + lo +
+      ", 0, 0], [" + hi + ", 0.2, 0.2]] }";
+  }
+  const complex::Complex k = lang::readComplexJson(json + "] }", "bar4.json");
+  mesh::ValidityReport v;
+  const mesh::TetMesh m = meshOf(k, 0.05, true, v);
+  EXPECT_TRUE(v.valid()) << mesh::formatValidityReport(v);
+  EXPECT_GT(v.minEdgeRelative, 0.1) << mesh::formatValidityReport(v);
+  const auto volumes = materialVolumes(m);
+  ASSERT_EQ(volumes.size(), 4u);
+  for (const auto& [material, volume] : volumes)
+  {
+    EXPECT_NEAR(volume, 0.04, 1e-3 * 0.04) << m.materialNames[std::size_t(material - 1)];
+  }
+}
+
 TEST_P(MeshSolvers, BarSolvesToSpringsInSeries)
 {
   // Pulled by F = 100 at x = 2: u = F / A (1 / E1 + 1 / E2). Exact with nu = 0 on any conforming

@@ -276,6 +276,22 @@ TEST(ComplexVTK, TetrahedralizeFilterLabelsEveryTetrahedron)
   }
   EXPECT_NEAR(volume[1], 0.04, 1e-9);
   EXPECT_NEAR(volume[2], 0.04, 1e-9);
+  // The validity check's figures (issue 21) as field data: the shortest edge of the bar's mesh
+  // is 0.213 x size, nothing duplicated, stray or non-conforming.
+  vtkFieldData* fd = grid->GetFieldData();
+  for (const char* name : { "MinEdgeLength", "MinEdgeLengthRelative", "MinTetrahedronVolume",
+         "MinTetrahedronVolumeRelative", "DuplicatePoints", "NonConformingFaces",
+         "StrayBoundaryFaces" })
+  {
+    ASSERT_NE(fd->GetArray(name), nullptr) << name;
+  }
+  EXPECT_GT(fd->GetArray("MinEdgeLengthRelative")->GetTuple1(0), 0.1);
+  EXPECT_NEAR(fd->GetArray("MinEdgeLength")->GetTuple1(0),
+    0.05 * fd->GetArray("MinEdgeLengthRelative")->GetTuple1(0), 1e-15);
+  EXPECT_GT(fd->GetArray("MinTetrahedronVolume")->GetTuple1(0), 0);
+  EXPECT_EQ(fd->GetArray("DuplicatePoints")->GetTuple1(0), 0);
+  EXPECT_EQ(fd->GetArray("NonConformingFaces")->GetTuple1(0), 0);
+  EXPECT_EQ(fd->GetArray("StrayBoundaryFaces")->GetTuple1(0), 0);
   // Without a complex on the input the filter fails with an error.
   vtkNew<ictkTetrahedralize> orphan;
   vtkNew<vtkPartitionedDataSetCollection> empty;

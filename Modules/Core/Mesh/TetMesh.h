@@ -51,7 +51,7 @@ struct TetraOptions
 {
   /// Target edge length (model units), > 0.
   double size = 0;
-  /// Identical output run to run (no random perturbation or exudation, fixed seeds).
+  /// Identical output run to run (no random perturbation, fixed seeds).
   bool deterministic = false;
   /// Refuse meshes estimated above this many tetrahedra (the estimate is in the message).
   double maxTetrahedra = 2e7;

@@ -1339,11 +1339,11 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
     CGAL::perturb_mesh_3(
       c3t3, domain, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
     report(options, 0.8);
-    labeller->setPhase(0.8);
-    CGAL::exude_mesh_3(
-      c3t3, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
-    report(options, 0.95);
   }
+  labeller->setPhase(0.8);
+  CGAL::exude_mesh_3(
+    c3t3, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
+  report(options, 0.95);
 
   // Output: the tetrahedra of the complex, vertices numbered in order of first use.
   TetMesh mesh;

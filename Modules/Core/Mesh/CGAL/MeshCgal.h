@@ -29,9 +29,11 @@ namespace ictk::mesh
 /// options.size is met on average: the mean tetrahedron has the volume of a regular one of edge
 /// `size` (so estimateTetrahedra predicts the count) and protected curves get edges of at most
 /// `size`. Refinement is sequential (options.threads is used for tracing the curves only).
-/// options.deterministic: no perturbation or exudation and fixed seeds (identical output run to
-/// run, but slivers remain: minimum dihedral angles near 0); otherwise perturbation and
-/// exudation aim at options.minDihedralDegrees.
+/// Sliver exudation (deterministic: no random choice, no time limit) aims at
+/// options.minDihedralDegrees in both modes; the default mode perturbs vertices first (random).
+/// options.deterministic: no perturbation and fixed seeds, identical output run to run and
+/// thread count to thread count (the flower: min dihedral 6.3 deg instead of 0.3 without
+/// exudation, 9.5 deg with perturbation).
 /// Throws std::invalid_argument for a 3D cell that is not implicit or not bounded, one the mesh
 /// has no tetrahedron of (no volume; naming it), more than 16 2D cells inside solids, for
 /// overlapping cells of equal priority (naming both and the point), or for an estimate above
