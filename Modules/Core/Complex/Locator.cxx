@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Complex/Locator.h"
 
+#include "FRep/Vector.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -12,18 +14,10 @@ namespace
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-double dot(const Point3& a, const Point3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-double norm(const Point3& a)
-{
-  return std::sqrt(dot(a, a));
-}
+using frep::distance;
+using frep::dot;
+using frep::norm;
+using frep::sub;
 
 /// |f| / |grad f|: the distance to {f = 0} to first order. A vanishing gradient gives |f|
 /// itself, which is large where f is, and so never claims a far point is near.

@@ -4,6 +4,7 @@
 // Curves.cxx, Points.cxx). Not part of the public API: the declarations may change freely.
 
 #include "Discretize/Mesh.h"
+#include "FRep/Vector.h"
 
 #include <cmath>
 #include <cstddef>
@@ -15,38 +16,15 @@
 namespace ictk::discretize::detail
 {
 
-inline Point3 add(const Point3& a, const Point3& b)
-{
-  return { a[0] + b[0], a[1] + b[1], a[2] + b[2] };
-}
-inline Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-inline Point3 scale(const Point3& a, double s)
-{
-  return { a[0] * s, a[1] * s, a[2] * s };
-}
-inline double dot(const Point3& a, const Point3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-inline Point3 cross(const Point3& a, const Point3& b)
-{
-  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-}
-inline double norm(const Point3& a)
-{
-  return std::sqrt(dot(a, a));
-}
-inline double distance(const Point3& a, const Point3& b)
-{
-  return norm(sub(a, b));
-}
-inline Point3 lerp(const Point3& a, const Point3& b, double t)
-{
-  return { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]) };
-}
+using frep::add;
+using frep::cross;
+using frep::distance;
+using frep::dot;
+using frep::lerp;
+using frep::norm;
+using frep::scale;
+using frep::sub;
+
 inline bool finite(const Point3& p)
 {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);

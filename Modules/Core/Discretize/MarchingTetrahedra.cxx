@@ -2,6 +2,7 @@
 #include "Discretize/MarchingTetrahedra.h"
 
 #include "FRep/Sampling.h"
+#include "FRep/Vector.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -22,22 +23,10 @@ namespace
 
 using frep::FieldEvaluator;
 
-Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-Point3 cross(const Point3& a, const Point3& b)
-{
-  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-}
-double dot(const Point3& a, const Point3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-Point3 lerp(const Point3& a, const Point3& b, double t)
-{
-  return { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]) };
-}
+using frep::cross;
+using frep::dot;
+using frep::lerp;
+using frep::sub;
 
 void checkBox(const Box3& box, double size, const char* what)
 {

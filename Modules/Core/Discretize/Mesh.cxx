@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Discretize/Mesh.h"
 
+#include "FRep/Vector.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -164,14 +166,9 @@ MeshTopology analyzeTopology(const SurfaceMesh& mesh)
 
 namespace
 {
-Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-Point3 cross(const Point3& a, const Point3& b)
-{
-  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-}
+using frep::cross;
+using frep::sub;
+
 } // namespace
 
 double surfaceArea(const SurfaceMesh& mesh)

@@ -2,6 +2,7 @@
 #include "Discretize/MultiMaterial.h"
 
 #include "FRep/Sampling.h"
+#include "FRep/Vector.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -29,22 +30,10 @@ using frep::FieldEvaluator;
 using Label = std::int16_t;
 constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
 
-Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-Point3 cross(const Point3& a, const Point3& b)
-{
-  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-}
-double dot(const Point3& a, const Point3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-Point3 lerp(const Point3& a, const Point3& b, double t)
-{
-  return { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]) };
-}
+using frep::cross;
+using frep::dot;
+using frep::lerp;
+using frep::sub;
 
 // The six tetrahedra of the Kuhn split (corners by bits x = 1, y = 2, z = 4); their edges all go
 // from a corner to one with more bits set, so the grid graph of tetrahedron edges has the seven

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Engine/Interpreter.h"
 
+#include "FRep/Vector.h"
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -538,7 +540,7 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
   {
     arity(1);
     const Vec3 v = vec(0);
-    const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    const double n = frep::norm(v);
     if (name == "length")
       return Value::real(n);
     if (n == 0.0)
@@ -550,9 +552,8 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
     arity(2);
     const Vec3 a = vec(0), b = vec(1);
     if (name == "dot")
-      return Value::real(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
-    return Value::vector(
-      { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] });
+      return Value::real(frep::dot(a, b));
+    return Value::vector(frep::cross(a, b));
   }
   if (functions_)
     for (const Procedure& p : *functions_)

@@ -48,6 +48,7 @@
 #include "Dynamics/RootFinding.h"
 #include "FRep/Expr.h"
 #include "FRep/Tape.h"
+#include "FRep/Vector.h"
 
 #include <algorithm>
 #include <cmath>
@@ -107,22 +108,10 @@ Vec3 lift(V2 p)
 {
   return { p.x, p.y, 0.0 };
 }
-Vec3 sub3(const Vec3& a, const Vec3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-double norm3(const Vec3& a)
-{
-  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-}
-double dist3(const Vec3& a, const Vec3& b)
-{
-  return norm3(sub3(a, b));
-}
 
 double boxDiagonal(const Box3& b)
 {
-  return norm3(sub3(b.hi, b.lo));
+  return frep::norm(frep::sub(b.hi, b.lo));
 }
 Box3 joinBoxes(const Box3& a, const Box3& b)
 {
@@ -927,7 +916,7 @@ struct Prepared
         return std::min({ 0.5 * p.size[0] - std::abs(l[0]), 0.5 * p.size[1] - std::abs(l[1]),
           0.5 * p.size[2] - std::abs(l[2]) });
       case ShapePart::Kind::Sphere:
-        return p.radius - norm3(l);
+        return p.radius - frep::norm(l);
       case ShapePart::Kind::Field:
       {
         // One point at a time: the gradient evaluator is cheaper than a batch of one.
@@ -1097,7 +1086,7 @@ struct Prepared
     };
     auto radial = [&](int axes)
     {
-      const double n = axes == 2 ? std::hypot(l[0], l[1]) : norm3(l);
+      const double n = axes == 2 ? std::hypot(l[0], l[1]) : frep::norm(l);
       v = p.radius - n;
       gl = { 0, 0, 0 };
       for (int i = 0; i < axes && n > 0; ++i)
@@ -1207,7 +1196,7 @@ struct Prepared
   {
     Vec3 g;
     const double v = gradient(w, g);
-    const double n = norm3(g);
+    const double n = frep::norm(g);
     return n > 0 ? std::abs(v) / n : (v == 0 ? 0 : Inf);
   }
 
@@ -1419,7 +1408,7 @@ std::vector<Vec3> mergeAndSort(const std::vector<Vec3>& points, double merge)
     bool seen = false;
     for (const auto& q : out)
     {
-      seen = seen || dist3(p, q) <= merge;
+      seen = seen || frep::distance(p, q) <= merge;
     }
     if (!seen)
     {
@@ -1541,7 +1530,7 @@ Vec3 footPoint(const Prepared& s, const Vec3& x, Vec3 y)
     }
     Vec3 g;
     s.gradient(y, g);
-    const double gn = norm3(g);
+    const double gn = frep::norm(g);
     if (gn > 0)
     {
       double along = 0;
@@ -1555,7 +1544,7 @@ Vec3 footPoint(const Prepared& s, const Vec3& x, Vec3 y)
         z[i] = x[i] - along * g[i] / gn;
       }
       // Move along the tangent plane only part of the way when far: the plane is first order.
-      const double move = dist3(z, y);
+      const double move = frep::distance(z, y);
       const double limit = 0.25 * s.scale;
       const double t = move > limit ? limit / move : 1.0;
       for (int i = 0; i < axes; ++i)
@@ -1563,7 +1552,7 @@ Vec3 footPoint(const Prepared& s, const Vec3& x, Vec3 y)
         y[i] += t * (z[i] - y[i]);
       }
     }
-    if (dist3(before, y) <= 1e-12 * s.scale)
+    if (frep::distance(before, y) <= 1e-12 * s.scale)
     {
       break;
     }
@@ -1625,7 +1614,7 @@ Vec3 closestPoint(const Prepared& s, Vec3 x)
     for (int j = 0; j < 3; ++j)
     {
       col[j] = { a[j], a[3 + j], a[6 + j] };
-      len[j] = norm3(col[j]);
+      len[j] = frep::norm(col[j]);
     }
     auto d = [&](int i, int j)
     {
@@ -1657,8 +1646,8 @@ Vec3 closestPoint(const Prepared& s, Vec3 x)
       std::abs(len[0] - len[2]) <= 1e-12 * big;
     if (similar && p.kind == ShapePart::Kind::Sphere)
     {
-      const Vec3 e = sub3(x, c);
-      const double n = norm3(e);
+      const Vec3 e = frep::sub(x, c);
+      const double n = frep::norm(e);
       const double r = p.radius * len[0];
       return n > 0 ? Vec3{ c[0] + r * e[0] / n, c[1] + r * e[1] / n, c[2] + r * e[2] / n }
                    : Vec3{ c[0] + r, c[1], c[2] };
@@ -1669,14 +1658,14 @@ Vec3 closestPoint(const Prepared& s, Vec3 x)
   // between two blobs), from where the segment to the nearest inside sample crosses it.
   const double onTol = 1e-6 * s.scale;
   Vec3 best = footPoint(s, x, x);
-  double bestDistance = s.boundaryDistance(best) <= onTol ? dist3(best, x) : Inf;
+  double bestDistance = s.boundaryDistance(best) <= onTol ? frep::distance(best, x) : Inf;
   const auto& inside = bestDistance < Inf ? std::vector<Vec3>{} : s.insideSamples();
   if (!inside.empty())
   {
     const Vec3* seed = &inside[0];
     for (const auto& q : inside)
     {
-      if (dist3(q, x) < dist3(*seed, x))
+      if (frep::distance(q, x) < frep::distance(*seed, x))
       {
         seed = &q;
       }
@@ -1693,13 +1682,14 @@ Vec3 closestPoint(const Prepared& s, Vec3 x)
     }
     const Vec3 crossing = in;
     const Vec3 refined = footPoint(s, x, crossing);
-    const Vec3 candidate =
-      s.boundaryDistance(refined) <= onTol && dist3(refined, x) <= dist3(crossing, x) ? refined
-                                                                                      : crossing;
-    if (dist3(candidate, x) < bestDistance)
+    const Vec3 candidate = s.boundaryDistance(refined) <= onTol &&
+        frep::distance(refined, x) <= frep::distance(crossing, x)
+      ? refined
+      : crossing;
+    if (frep::distance(candidate, x) < bestDistance)
     {
       best = candidate;
-      bestDistance = dist3(candidate, x);
+      bestDistance = frep::distance(candidate, x);
     }
   }
   return best;
@@ -1785,7 +1775,7 @@ double lowestInside(const Prepared& a, const Prepared& b, Vec3& x, double step, 
         d[i] -= out / gb2 * gb[i];
       }
     }
-    const double dn = norm3(d);
+    const double dn = frep::norm(d);
     if (!(dn > 0))
     {
       break;
@@ -1825,7 +1815,7 @@ double alternatingFrom(const Prepared& first, const Prepared& second, const Vec3
   const double scale = std::max(first.scale, second.scale);
   Vec3 p = closestPoint(first, seed);
   Vec3 q = closestPoint(second, p);
-  double d = dist3(p, q);
+  double d = frep::distance(p, q);
   for (int it = 0; it < 500 && d > 0; ++it)
   {
     if (it == 16 && first.solid() && second.solid())
@@ -1841,18 +1831,18 @@ double alternatingFrom(const Prepared& first, const Prepared& second, const Vec3
       {
         const Vec3 p2 = closestPoint(first, x);
         const Vec3 q2 = closestPoint(second, p2);
-        if (dist3(p2, q2) < d)
+        if (frep::distance(p2, q2) < d)
         {
           p = p2;
           q = q2;
-          d = dist3(p2, q2);
+          d = frep::distance(p2, q2);
           continue;
         }
       }
     }
     const Vec3 p2 = closestPoint(first, q);
     const Vec3 q2 = closestPoint(second, p2);
-    const double d2 = dist3(p2, q2);
+    const double d2 = frep::distance(p2, q2);
     p = p2;
     q = q2;
     // The distance is stationary at the nearest pair, so its error is about the last
@@ -2052,7 +2042,7 @@ double separation(const Prepared& a, const Prepared& b, double enough)
   double ra, rb;
   if (sphereSphere(a, ca, ra) && sphereSphere(b, cb, rb))
   {
-    return std::max(0.0, dist3(ca, cb) - ra - rb);
+    return std::max(0.0, frep::distance(ca, cb) - ra - rb);
   }
   double d = alternatingDistance(a, b, enough);
   if (d <= enough || !a.solid() || !b.solid())
@@ -2807,8 +2797,8 @@ bool contains(const Shape& a, const Shape& b, const QueryOptions& o)
     {
       break;
     }
-    if (std::any_of(
-          ends.begin(), ends.end(), [&](const Vec3& e) { return dist3(e, seed.second) <= reach; }))
+    if (std::any_of(ends.begin(), ends.end(),
+          [&](const Vec3& e) { return frep::distance(e, seed.second) <= reach; }))
     {
       continue;
     }
@@ -3022,7 +3012,7 @@ double intersectionMeasure(const Shape& a, const Shape& b, const QueryOptions& o
   double r1, r2;
   if (sphereSphere(pa, ca, r1) && sphereSphere(pb, cb, r2))
   {
-    return sphereLens(r1, r2, dist3(ca, cb));
+    return sphereLens(r1, r2, frep::distance(ca, cb));
   }
   Box3 ba, bb;
   if (worldAxisBox(pa, ba) && worldAxisBox(pb, bb))

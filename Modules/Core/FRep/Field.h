@@ -10,6 +10,7 @@
 
 #include "FRep/Interval.h"
 #include "FRep/Tape.h"
+#include "FRep/Vector.h"
 
 #include <array>
 #include <cstddef>
@@ -19,8 +20,6 @@
 
 namespace ictk::frep
 {
-
-using Point3 = std::array<double, 3>;
 
 /// An axis-aligned box of E^3.
 struct Box3

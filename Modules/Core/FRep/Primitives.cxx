@@ -3,6 +3,7 @@
 // (repository pmur002/hyperfun, src/hflibrary_lib/hf*.c); where those are wrong or fragile the
 // comment says what differs and why. Every field is an Expr, so every evaluator supports it.
 #include "FRep/Primitives.h"
+#include "FRep/Vector.h"
 
 #include <algorithm>
 #include <cmath>
@@ -97,25 +98,11 @@ void requireNonEmpty(const char* primitive, const char* name, std::size_t n)
 
 // --- small vector helpers (build-time doubles and field-time Exprs) -----------------------------
 
-Vec3 sub(const Vec3& a, const Vec3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-
-double dot(const Vec3& a, const Vec3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-Vec3 cross(const Vec3& a, const Vec3& b)
-{
-  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-}
-
-Vec3 scaled(const Vec3& a, double k)
-{
-  return { a[0] * k, a[1] * k, a[2] * k };
-}
+// FRep/Vector.h for doubles (named here: the Expr overloads below would hide them).
+using frep::cross;
+using frep::dot;
+using frep::scale;
+using frep::sub;
 
 struct EVec
 {
@@ -237,7 +224,7 @@ Expr segmentField(
   {
     fail(primitive, what + " has zero length (its two ends coincide)");
   }
-  const Vec3 a = scaled(axis, 1.0 / l);
+  const Vec3 a = scale(axis, 1.0 / l);
   const double s2 = s * s;
   const EVec d = fromPoint(b);
   const Expr x = dot(d, a);
@@ -291,7 +278,7 @@ Expr arcField(const char* primitive, const std::string& what, const Vec3& center
   EVec local = fromPoint(center);
   if (angleDegrees != 0)
   {
-    const auto m = rotationMatrix(scaled(axis, 1.0 / axisLength), -angleDegrees * pi / 180.0);
+    const auto m = rotationMatrix(scale(axis, 1.0 / axisLength), -angleDegrees * pi / 180.0);
     const EVec d = local;
     local = { dot(d, m[0]), dot(d, m[1]), dot(d, m[2]) };
   }
@@ -368,14 +355,14 @@ Expr triangleField(
   {
     fail(primitive, what + " is degenerate (zero area)");
   }
-  const Vec3 uHat = scaled(edge, 1.0 / edgeLength);
+  const Vec3 uHat = scale(edge, 1.0 / edgeLength);
   const double a1l = dot(sub(a3, a1), uHat);
   const double a2l = edgeLength - a1l;
   const Vec3 foot = { a1[0] + a1l * uHat[0], a1[1] + a1l * uHat[1], a1[2] + a1l * uHat[2] };
   const Vec3 altitude = sub(a3, foot);
   const double h = std::sqrt(dot(altitude, altitude));
-  const Vec3 vHat = scaled(altitude, 1.0 / h);
-  const Vec3 nHat = scaled(normal, 1.0 / twiceArea);
+  const Vec3 vHat = scale(altitude, 1.0 / h);
+  const Vec3 nHat = scale(normal, 1.0 / twiceArea);
   const double inverseS2 = 1.0 / (s * s);
 
   const EVec d = fromPoint(foot);
@@ -649,7 +636,7 @@ Shape halfSpace(const Vec3& point, const Vec3& inwardNormal)
   {
     fail("halfSpace", "inwardNormal must not be the zero vector");
   }
-  return Shape(dot(fromPoint(point), scaled(inwardNormal, 1.0 / length)), Domain::XYZ, "halfSpace");
+  return Shape(dot(fromPoint(point), scale(inwardNormal, 1.0 / length)), Domain::XYZ, "halfSpace");
 }
 
 // --- skeletal primitives

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Mesh/Quality.h"
 
+#include "FRep/Vector.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -19,20 +21,9 @@ namespace
 constexpr double pi = 3.14159265358979323846;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-
-Point3 cross(const Point3& a, const Point3& b)
-{
-  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-}
-
-double dot(const Point3& a, const Point3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+using frep::cross;
+using frep::dot;
+using frep::sub;
 
 double degrees(double radians)
 {

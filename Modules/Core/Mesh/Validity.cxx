@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Mesh/Validity.h"
 
+#include "FRep/Vector.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -26,24 +28,10 @@ constexpr Point3 kDirections[14] = { { 1, 0, 0 }, { -1, 0, 0 }, { 0, 1, 0 }, { 0
   { 0, 0, 1 }, { 0, 0, -1 }, { kD, kD, kD }, { kD, kD, -kD }, { kD, -kD, kD }, { kD, -kD, -kD },
   { -kD, kD, kD }, { -kD, kD, -kD }, { -kD, -kD, kD }, { -kD, -kD, -kD } };
 
-double distance(const Point3& a, const Point3& b)
-{
-  const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
-  return std::sqrt(dx * dx + dy * dy + dz * dz);
-}
-
-Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-double dot(const Point3& a, const Point3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-Point3 cross(const Point3& a, const Point3& b)
-{
-  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-}
+using frep::cross;
+using frep::distance;
+using frep::dot;
+using frep::sub;
 
 /// 6 x the signed volume of (a, b, c, d).
 double orient(const Point3& a, const Point3& b, const Point3& c, const Point3& d)

@@ -6,6 +6,7 @@
 #include "Complex/Discretization.h"
 #include "Discretize/Curves.h"
 #include "FRep/Sampling.h"
+#include "FRep/Vector.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Labeled_mesh_domain_3.h>
@@ -55,19 +56,10 @@ constexpr double kFacetRadius = 0.75;
 constexpr double kCellRadius = 0.8;
 
 // --- small vector helpers ---------------------------------------------------------------------
-Point3 sub(const Point3& a, const Point3& b)
-{
-  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
-}
-double dot(const Point3& a, const Point3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-double dist(const Point3& a, const Point3& b)
-{
-  const Point3 d = sub(a, b);
-  return std::sqrt(dot(d, d));
-}
+using frep::distance;
+using frep::dot;
+using frep::sub;
+
 /// The point of segment [a, b] nearest to p.
 Point3 nearestOnSegment(const Point3& p, const Point3& a, const Point3& b)
 {
@@ -95,7 +87,7 @@ Box3 padded(const Box3& b, double pad)
 }
 double diagonal(const Box3& b)
 {
-  return dist(b.lo, b.hi);
+  return distance(b.lo, b.hi);
 }
 
 // --- the 3D cells as one labelled domain ------------------------------------------------------
@@ -796,7 +788,7 @@ void cleanPolylines(std::vector<Polyline>& lines, double tolerance)
     Polyline p;
     for (const auto& q : line)
     {
-      if (p.empty() || dist(p.back(), q) > tolerance * 1e-3)
+      if (p.empty() || distance(p.back(), q) > tolerance * 1e-3)
       {
         p.push_back(q);
       }
@@ -804,7 +796,7 @@ void cleanPolylines(std::vector<Polyline>& lines, double tolerance)
     const bool closed = line.size() > 2 && line.front() == line.back();
     if (closed && p.size() > 1 && p.back() != p.front())
     {
-      if (dist(p.back(), p.front()) <= tolerance * 1e-3)
+      if (distance(p.back(), p.front()) <= tolerance * 1e-3)
       {
         p.back() = p.front();
       }
@@ -816,7 +808,7 @@ void cleanPolylines(std::vector<Polyline>& lines, double tolerance)
     double length = 0;
     for (std::size_t i = 1; i < p.size(); ++i)
     {
-      length += dist(p[i - 1], p[i]);
+      length += distance(p[i - 1], p[i]);
     }
     if (p.size() >= 2 && length > tolerance && !(p.size() <= 3 && p.front() == p.back()))
     {
@@ -831,7 +823,7 @@ double distanceToPolyline(const Point3& p, const Polyline& line)
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 1; i < line.size(); ++i)
   {
-    best = std::min(best, dist(p, nearestOnSegment(p, line[i - 1], line[i])));
+    best = std::min(best, distance(p, nearestOnSegment(p, line[i - 1], line[i])));
   }
   return best;
 }
@@ -879,7 +871,7 @@ std::vector<Polyline> mergeFeatures(
   {
     for (const auto& c : corners)
     {
-      if (dist(c, p) <= snap)
+      if (distance(c, p) <= snap)
       {
         p = c;
         return;
@@ -915,7 +907,7 @@ std::vector<Polyline> mergeFeatures(
         double best = std::numeric_limits<double>::infinity();
         for (std::size_t i = 1; i < a.size(); ++i)
         {
-          const double d = dist(c, nearestOnSegment(c, a[i - 1], a[i]));
+          const double d = distance(c, nearestOnSegment(c, a[i - 1], a[i]));
           if (d < best)
           {
             best = d;
@@ -928,12 +920,12 @@ std::vector<Polyline> mergeFeatures(
         }
         // Insert c as a vertex: replace a near vertex, else add it inside segment `seg`.
         std::size_t at = 0;
-        if (dist(c, a[seg - 1]) <= snap && (seg - 1 > 0 || isClosed(a)))
+        if (distance(c, a[seg - 1]) <= snap && (seg - 1 > 0 || isClosed(a)))
         {
           at = seg - 1;
           a[at] = c;
         }
-        else if (dist(c, a[seg]) <= snap && (seg < a.size() - 1 || isClosed(a)))
+        else if (distance(c, a[seg]) <= snap && (seg < a.size() - 1 || isClosed(a)))
         {
           at = seg;
           a[at] = c;
@@ -1205,7 +1197,7 @@ void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& so
           // the bisection's error: both inserted, they left clusters of vertices 1e-8 apart that
           // refinement never removes (issue 21's micro-tetrahedra).
           const bool nearSeed = std::any_of(seeds.begin(), seeds.end(),
-            [&](const Point3& s) { return dist(point, s) < 0.5 * size; });
+            [&](const Point3& s) { return distance(point, s) < 0.5 * size; });
           if (nearCurve || nearSeed)
           {
             continue;
