@@ -16,13 +16,16 @@ namespace ictk::discretize
 using frep::Box3;
 using frep::Point3;
 
-/// Named per-point values with a fixed component count, interleaved.
-struct PointArray
+/// Named values per element (point, triangle, tetrahedron) with a fixed component count,
+/// interleaved: one type for every mesh of the toolkit, as vtkDataArray is for VTK's.
+struct DataArray
 {
   std::string name;
   int components = 1;
   std::vector<double> values;
 };
+/// Values per point.
+using PointArray = DataArray;
 
 /// A triangle surface (2D cells, boundaries of 3D cells).
 struct SurfaceMesh

@@ -20,13 +20,8 @@ namespace ictk::mesh
 
 using frep::Point3;
 
-/// Values per tetrahedron, `components` interleaved.
-struct TetArray
-{
-  std::string name;
-  int components = 1;
-  std::vector<double> values;
-};
+/// Values per tetrahedron.
+using TetArray = discretize::DataArray;
 
 struct TetMesh
 {
