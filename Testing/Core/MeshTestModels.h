@@ -5,8 +5,8 @@
 // area of the faces a mesh has on a plane (internal surfaces).
 
 #include "Lang/ComplexFile.h"
-#include "Mesh/Attributes.h"
 #include "Mesh/Structured.h"
+#include "Mesh/TetAttributes.h"
 
 #include <algorithm>
 #include <array>

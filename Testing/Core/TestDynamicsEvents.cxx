@@ -175,7 +175,7 @@ TEST(DynamicsEvents, TimeRejectedLimits)
     back.step(1.0);
     FAIL();
   }
-  catch (const ModelError& e)
+  catch (const SteppingError& e)
   {
     EXPECT_THAT(e.what(), HasSubstr("L2082"));
   }

@@ -30,14 +30,14 @@ TEST(DynamicsTime, UnionOfIntervalsIsNormalised)
 {
   const TimeSpan t = twoIntervals();
   ASSERT_EQ(t.intervals().size(), 2u);
-  EXPECT_EQ(t.intervals()[0], (Interval{ 0, 3 }));
-  EXPECT_EQ(t.intervals()[1], (Interval{ 4, 6 }));
+  EXPECT_EQ(t.intervals()[0], (TimeInterval{ 0, 3 }));
+  EXPECT_EQ(t.intervals()[1], (TimeInterval{ 4, 6 }));
   EXPECT_EQ(t.scale(), 2.0);
   EXPECT_EQ(t.start(), 0.0);
   EXPECT_EQ(t.end(), 6.0);
   EXPECT_EQ(t.duration(), 5.0); // 3 + 2
   // Touching intervals merge as well: [0,1] U [1,2] = [0,2].
-  EXPECT_EQ(TimeSpan({ { 1, 2 }, { 0, 1 } }).intervals(), (std::vector<Interval>{ { 0, 2 } }));
+  EXPECT_EQ(TimeSpan({ { 1, 2 }, { 0, 1 } }).intervals(), (std::vector<TimeInterval>{ { 0, 2 } }));
 }
 
 TEST(DynamicsTime, MembershipIsClosed)
@@ -92,17 +92,17 @@ TEST(DynamicsTime, ClipUnionIntersection)
   const TimeSpan t = twoIntervals();
   // [0,3] U [4,6] clipped to [2,5] = [2,3] U [4,5]; the scale is kept.
   const TimeSpan c = t.clipped({ 2, 5 });
-  EXPECT_EQ(c.intervals(), (std::vector<Interval>{ { 2, 3 }, { 4, 5 } }));
+  EXPECT_EQ(c.intervals(), (std::vector<TimeInterval>{ { 2, 3 }, { 4, 5 } }));
   EXPECT_EQ(c.scale(), 2.0);
   // U [2.5, 4.5] fills the gap: [0,6].
   EXPECT_EQ(
-    unite(t, TimeSpan::interval(2.5, 4.5)).intervals(), (std::vector<Interval>{ { 0, 6 } }));
+    unite(t, TimeSpan::interval(2.5, 4.5)).intervals(), (std::vector<TimeInterval>{ { 0, 6 } }));
   // n [1,5] = [1,3] U [4,5].
   EXPECT_EQ(intersect(t, TimeSpan::interval(1, 5)).intervals(),
-    (std::vector<Interval>{ { 1, 3 }, { 4, 5 } }));
+    (std::vector<TimeInterval>{ { 1, 3 }, { 4, 5 } }));
   // Closed intervals meet in an instant: [0,1] n [1,2] = [1,1].
   EXPECT_EQ(intersect(TimeSpan::interval(0, 1), TimeSpan::interval(1, 2)).intervals(),
-    (std::vector<Interval>{ { 1, 1 } }));
+    (std::vector<TimeInterval>{ { 1, 1 } }));
   EXPECT_TRUE(intersect(TimeSpan::interval(0, 1), TimeSpan::interval(2, 3)).empty());
 }
 

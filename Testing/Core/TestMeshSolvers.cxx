@@ -6,9 +6,9 @@
 
 #include "CalculixRun.h"
 #include "Lang/ComplexFile.h"
-#include "Mesh/Attributes.h"
 #include "Mesh/Backends/Backends.h"
 #include "Mesh/Quality.h"
+#include "Mesh/TetAttributes.h"
 #include "Mesh/Validity.h"
 #include "Mesh/Writers.h"
 #include "MeshTestModels.h"

@@ -236,7 +236,7 @@ bool Stepper::frame(double tNew, double h, double& requested)
   {
     const Event ev = queue_.pop();
     if (++dispatched > options_.maxEventsPerFrame)
-      throw ModelError("more than maxEventsPerFrame events in the frame at t = " +
+      throw SteppingError("more than maxEventsPerFrame events in the frame at t = " +
         std::to_string(tNew) + " (an event loop?)");
     for (std::size_t i : reactionOrder_)
     {
@@ -271,7 +271,7 @@ void Stepper::settle()
   if (!accepted)
   {
     restore(s);
-    throw ModelError("a reaction rejected the time while the model settled at t = " +
+    throw SteppingError("a reaction rejected the time while the model settled at t = " +
       std::to_string(t_) + " (there is no earlier time to go back to)");
   }
 }
@@ -318,8 +318,8 @@ int Stepper::step(double dt)
       restore(s);
       ++rejections_;
       if (!std::isnan(requested) && requested <= 0.0)
-        throw ModelError("TIME_REJECTED requests a time before the last correctly evaluated "
-                         "time " +
+        throw SteppingError("TIME_REJECTED requests a time before the last correctly evaluated "
+                            "time " +
           std::to_string(t_) + ": the model is invalid (thesis L2082)");
       h = (!std::isnan(requested) && requested < h) ? requested : 0.5 * h;
       if (++halvings > options_.maxHalvings)

@@ -25,7 +25,7 @@
 // event queue, life flags, logs) is restored to t and the frame is retried at t + h', where h' is
 // the step the reaction requested (relative to t) when it is smaller than h, else h / 2. After
 // maxHalvings rejections of one attempt, StepRejectedError. A requested step <= 0 would go back
-// before the last correctly evaluated time, which makes the model invalid (L2082): ModelError.
+// before the last correctly evaluated time, which makes the model invalid (L2082): SteppingError.
 // An exception thrown by a callback also restores the state before it propagates.
 // After an accepted sub-step the stepper continues with steps of the accepted size until the
 // requested time is reached, so the caller always gets the state at the time it asked for
@@ -58,7 +58,10 @@ public:
   using std::runtime_error::runtime_error;
 };
 
-class ModelError : public std::runtime_error
+/// The model cannot be stepped on: a requested time before the last correct one, more events in
+/// a frame than allowed, a rejection while the model settles. (engine::ModelError is the .icm
+/// runtime's error with a place in the model text.)
+class SteppingError : public std::runtime_error
 {
 public:
   using std::runtime_error::runtime_error;
@@ -147,7 +150,7 @@ public:
   int step(double dt);
   /// Evaluates one frame at time() without advancing it (dt = 0): every relation is evaluated
   /// once, so the model starts from a consistent state. A reaction that rejects the time there
-  /// is a ModelError.
+  /// is a SteppingError.
   void settle();
 
   /// Advances by dt unless guard(params, t) reaches 0 inside the step (locateCrossing); then

@@ -8,12 +8,12 @@
 namespace ictk::dyn
 {
 
-TimeSpan::TimeSpan(std::vector<Interval> intervals, double scale)
+TimeSpan::TimeSpan(std::vector<TimeInterval> intervals, double scale)
   : scale_(scale)
 {
   if (!(std::isfinite(scale) && scale > 0.0))
     throw std::invalid_argument("TimeSpan: the time scale must be finite and > 0");
-  for (const Interval& i : intervals)
+  for (const TimeInterval& i : intervals)
   {
     if (std::isnan(i.start) || std::isnan(i.end))
       throw std::invalid_argument("TimeSpan: NaN interval end");
@@ -21,9 +21,9 @@ TimeSpan::TimeSpan(std::vector<Interval> intervals, double scale)
       throw std::invalid_argument("TimeSpan: interval start after its end");
   }
   std::sort(intervals.begin(), intervals.end(),
-    [](const Interval& a, const Interval& b)
+    [](const TimeInterval& a, const TimeInterval& b)
     { return a.start < b.start || (a.start == b.start && a.end < b.end); });
-  for (const Interval& i : intervals)
+  for (const TimeInterval& i : intervals)
   {
     if (!intervals_.empty() && i.start <= intervals_.back().end)
       intervals_.back().end = std::max(intervals_.back().end, i.end);
@@ -59,7 +59,7 @@ double TimeSpan::end() const
 double TimeSpan::duration() const
 {
   double d = 0.0;
-  for (const Interval& i : intervals_)
+  for (const TimeInterval& i : intervals_)
     d += i.length();
   return d;
 }
@@ -68,7 +68,7 @@ std::optional<std::size_t> TimeSpan::intervalIndex(double t) const
 {
   // The intervals are sorted and disjoint: the candidate is the last one starting at or before t.
   auto it = std::upper_bound(intervals_.begin(), intervals_.end(), t,
-    [](double v, const Interval& i) { return v < i.start; });
+    [](double v, const TimeInterval& i) { return v < i.start; });
   if (it == intervals_.begin())
     return std::nullopt;
   --it;
@@ -101,7 +101,7 @@ double TimeSpan::globalTime(double localT, std::size_t index) const
 double TimeSpan::elapsed(double globalT) const
 {
   double e = 0.0;
-  for (const Interval& i : intervals_)
+  for (const TimeInterval& i : intervals_)
   {
     if (globalT < i.start)
       break;
@@ -122,7 +122,7 @@ std::optional<double> TimeSpan::globalTimeOfLife(double lifeT) const
 {
   double before = 0.0; // unscaled time spent in earlier intervals
   const double target = lifeT / scale_;
-  for (const Interval& i : intervals_)
+  for (const TimeInterval& i : intervals_)
   {
     const double origin = std::isfinite(i.start) ? i.start : 0.0;
     const double t = origin + (target - before);
@@ -133,21 +133,21 @@ std::optional<double> TimeSpan::globalTimeOfLife(double lifeT) const
   return std::nullopt;
 }
 
-TimeSpan TimeSpan::clipped(Interval window) const
+TimeSpan TimeSpan::clipped(TimeInterval window) const
 {
   return intersect(*this, TimeSpan({ window }, 1.0));
 }
 
 TimeSpan unite(const TimeSpan& a, const TimeSpan& b)
 {
-  std::vector<Interval> all = a.intervals();
+  std::vector<TimeInterval> all = a.intervals();
   all.insert(all.end(), b.intervals().begin(), b.intervals().end());
   return TimeSpan(std::move(all), a.scale());
 }
 
 TimeSpan intersect(const TimeSpan& a, const TimeSpan& b)
 {
-  std::vector<Interval> out;
+  std::vector<TimeInterval> out;
   std::size_t i = 0, j = 0;
   const auto& x = a.intervals();
   const auto& y = b.intervals();

@@ -25,13 +25,13 @@ namespace ictk::dyn
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 /// A closed interval of global time, [start, end]; start <= end; either end may be infinite.
-struct Interval
+struct TimeInterval
 {
   double start = 0.0;
   double end = 0.0;
   bool contains(double t) const { return start <= t && t <= end; }
   double length() const { return end - start; }
-  bool operator==(const Interval& o) const { return start == o.start && end == o.end; }
+  bool operator==(const TimeInterval& o) const { return start == o.start && end == o.end; }
 };
 
 class TimeSpan
@@ -41,14 +41,14 @@ public:
   TimeSpan() = default;
   /// The union of `intervals` (sorted, overlapping or touching ones merged). Throws
   /// std::invalid_argument for NaN ends, start > end, or a scale that is not finite and > 0.
-  explicit TimeSpan(std::vector<Interval> intervals, double scale = 1.0);
+  explicit TimeSpan(std::vector<TimeInterval> intervals, double scale = 1.0);
 
   /// (-inf, +inf) with the given scale: a TIMESPAN declared without arguments (ch4 feature 22).
   static TimeSpan infinite(double scale = 1.0);
   static TimeSpan interval(double start, double end, double scale = 1.0);
   static TimeSpan instant(double t) { return interval(t, t); }
 
-  const std::vector<Interval>& intervals() const { return intervals_; }
+  const std::vector<TimeInterval>& intervals() const { return intervals_; }
   double scale() const { return scale_; }
   bool empty() const { return intervals_.empty(); }
   /// First start / last end (throws std::logic_error when empty).
@@ -74,7 +74,7 @@ public:
   std::optional<double> globalTimeOfLife(double lifeT) const;
 
   /// The part of the span inside [window.start, window.end]; keeps the scale.
-  TimeSpan clipped(Interval window) const;
+  TimeSpan clipped(TimeInterval window) const;
 
   bool operator==(const TimeSpan& o) const
   {
@@ -82,7 +82,7 @@ public:
   }
 
 private:
-  std::vector<Interval> intervals_;
+  std::vector<TimeInterval> intervals_;
   double scale_ = 1.0;
 };
 

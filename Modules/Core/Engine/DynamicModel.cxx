@@ -399,7 +399,7 @@ void DynamicModel::Impl::buildTimespans()
   EngineScope scope(*this, {}, kNone);
   for (const auto& t : model.timespans)
   {
-    std::vector<dyn::Interval> intervals;
+    std::vector<dyn::TimeInterval> intervals;
     std::vector<double> plain;
     for (const ExprPtr& a : t.args)
     {
@@ -577,7 +577,7 @@ void DynamicModel::Impl::buildCell(const CellDef& def)
         span = timespans.at(v->text);
       else
       {
-        std::vector<dyn::Interval> in;
+        std::vector<dyn::TimeInterval> in;
         for (const ExprPtr& e : p.values)
           if (e->kind == Expr::Kind::Brace && e->kids.size() == 2)
             in.push_back({ interpreter.evaluate(*e->kids[0], scope).number,
@@ -1556,7 +1556,7 @@ void DynamicModel::Impl::step(double dt)
   {
     stepper->step(dt);
   }
-  catch (const dyn::ModelError& e)
+  catch (const dyn::SteppingError& e)
   {
     fail({ 0, 0 }, e.what());
   }
@@ -1572,7 +1572,7 @@ void DynamicModel::Impl::settle()
   {
     stepper->settle();
   }
-  catch (const dyn::ModelError& e)
+  catch (const dyn::SteppingError& e)
   {
     fail(instances[s.active].pos, e.what());
   }
@@ -1892,7 +1892,7 @@ std::pair<double, double> DynamicModel::timeRange() const
 {
   double lo = dyn::kInfinity, hi = -dyn::kInfinity;
   for (const auto& [n, span] : impl_->timespans)
-    for (const dyn::Interval& i : span.intervals())
+    for (const dyn::TimeInterval& i : span.intervals())
     {
       if (std::isfinite(i.start))
         lo = std::min(lo, i.start);

@@ -3,8 +3,8 @@
 
 #include "Mesh/Validity.h"
 
-#include "Mesh/Attributes.h"
 #include "Mesh/Quality.h"
+#include "Mesh/TetAttributes.h"
 
 #include <algorithm>
 #include <cctype>

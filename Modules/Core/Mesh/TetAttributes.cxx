@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "Mesh/Attributes.h"
+#include "Mesh/TetAttributes.h"
 
 #include <algorithm>
 #include <map>
