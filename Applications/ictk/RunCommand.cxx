@@ -428,7 +428,7 @@ CLI::App* AddRunCommand(CLI::App& app, RunModelOptions& o)
   run->add_option("--trace", o.Trace,
     "Also write a JSON-lines trace: one object per evaluated time (frames and located "
     "transitions) with time, instance, transition, events and state");
-  run->add_option("--feature-size", o.FeatureSize,
+  run->add_option("--size,--feature-size", o.FeatureSize,
     "Mesh edge length and curve step, the same for every frame (default: 1/64 of the complex's "
     "size at the model's start)");
   run->add_option("--max-step", o.MaxStep, "The engine's largest time step (default: DT)");
@@ -444,7 +444,7 @@ int RunModel(const RunModelOptions& o)
   const std::vector<double> times = ParseTimeSpec(o.Time);
   if (!std::isfinite(o.FeatureSize) || o.FeatureSize < 0)
   {
-    throw std::invalid_argument("--feature-size must be a finite number >= 0");
+    throw std::invalid_argument("--size must be a finite number >= 0");
   }
   if (!std::isfinite(o.MaxStep) || o.MaxStep < 0)
   {

@@ -74,7 +74,8 @@ CLI::App* AddTetraCommand(CLI::App& app, TetraOptions& o)
   tetra->add_option("-o,--output", o.Output, "Output: .vtu, .msh (Gmsh 4.1), .inp, .mesh")
     ->required();
   tetra->add_option("--backend", o.Backend, "cgal or tetgen (default: cgal when built)");
-  tetra->add_option("--size", o.Size, "Target edge length (default: 1/32 of the complex's size)");
+  tetra->add_option(
+    "--size,--feature-size", o.Size, "Target edge length (default: 1/32 of the complex's size)");
   tetra->add_flag("--deterministic", o.Deterministic, "Identical output run to run");
   tetra->add_option("--max-tets", o.MaxTetrahedra, "Refuse meshes estimated above this");
   tetra->add_option("--threads", o.Threads, "Threads (default: all cores)");

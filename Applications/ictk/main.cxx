@@ -1069,7 +1069,7 @@ int Run(int argc, char** argv)
     ->add_option("-o,--output", meshOptions.Output,
       "Output surface (.vtp, .stl, .ply, .obj) or complex (.vtpc, .vtm)")
     ->required();
-  mesh->add_option("--feature-size", meshFeatureSize,
+  mesh->add_option("--size,--feature-size", meshFeatureSize,
     "Complexes: mesh edge length and curve step (default: 1/64 of the complex's size)");
   int meshVolumeResolution = 0;
   mesh->add_option("--volume-resolution", meshVolumeResolution,
@@ -1092,7 +1092,7 @@ int Run(int argc, char** argv)
     "Check every declared boundary and containment pair against the geometry; exit 1 when one "
     "is violated");
   validate->add_option("model", validateOptions.Model, "A .json complex")->required();
-  validate->add_option("--feature-size", validateOptions.FeatureSize,
+  validate->add_option("--size,--feature-size", validateOptions.FeatureSize,
     "Discretisation step (default: 1/64 of the complex's size)");
   validate->add_option("--tolerance", validateOptions.Tolerance,
     "Distance within which a point counts as on a set (default: a quarter of the step)");

@@ -321,7 +321,8 @@ def check_complex_flower(ictk, work, data):
     if boundary < 0 or assembly.GetNumberOfChildren(boundary) != 8:
         sys.exit("FAIL: the assembly lacks /flower/relations/boundary with the 8 cells that have a boundary")
     vtm = os.path.join(work, "flower.vtm")
-    run(ictk, ["mesh", model, "-o", vtm, "--feature-size", "0.03"])
+    # --size is the edge length in every command; --feature-size its older spelling.
+    run(ictk, ["mesh", model, "-o", vtm, "--size", "0.03"])
     m = vtk.vtkXMLMultiBlockDataReader()
     m.SetFileName(vtm)
     m.Update()
