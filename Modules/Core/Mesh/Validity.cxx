@@ -3,6 +3,8 @@
 
 #include "FRep/Vector.h"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -323,7 +325,9 @@ ValidityReport checkValidity(
       faces.push_back({ v, static_cast<std::uint32_t>(t), k });
     }
   }
-  std::sort(faces.begin(), faces.end(),
+  // The sort is most of the check's time (6 M faces at 1.5 M tetrahedra); the keys are unique
+  // (face, tetrahedron), so the parallel sort's order is the sequential one.
+  tbb::parallel_sort(faces.begin(), faces.end(),
     [](const Face& a, const Face& b) { return a.v != b.v ? a.v < b.v : a.tet < b.tet; });
   std::optional<CellMembership> membership;
   if (complex)
