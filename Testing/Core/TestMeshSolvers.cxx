@@ -41,14 +41,16 @@ protected:
   }
 };
 
+/// Volume per material id, for the materials with tetrahedra.
 std::map<std::int32_t, double> materialVolumes(const mesh::TetMesh& m)
 {
   std::map<std::int32_t, double> v;
-  for (std::size_t t = 0; t < m.tetrahedra.size(); ++t)
+  for (const mesh::MaterialQuality& q : mesh::measureQuality(m).materials)
   {
-    const auto& tet = m.tetrahedra[t];
-    v[m.materials[t]] +=
-      mesh::tetShape(m.points[tet[0]], m.points[tet[1]], m.points[tet[2]], m.points[tet[3]]).volume;
+    if (q.tetrahedra > 0)
+    {
+      v[q.material] = q.volume;
+    }
   }
   return v;
 }

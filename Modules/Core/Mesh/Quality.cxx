@@ -169,7 +169,7 @@ TetShape tetShape(const Point3& a, const Point3& b, const Point3& c, const Point
   const Point3 p[4] = { a, b, c, d };
   TetShape s;
   const Point3 e1 = sub(b, a), e2 = sub(c, a), e3 = sub(d, a);
-  const double det = dot(e1, cross(e2, e3));
+  const double det = orientation(a, b, c, d);
   s.volume = det / 6;
 
   // Outward unit normals of the faces opposite each vertex.

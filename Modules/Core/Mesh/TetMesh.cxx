@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Mesh/TetMesh.h"
 
+#include "FRep/Vector.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -14,6 +16,11 @@ double estimateTetrahedra(double volume, double size)
     throw std::invalid_argument("the mesh size must be a positive number");
   }
   return volume / (size * size * size / (6 * std::sqrt(2.0)));
+}
+
+double orientation(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
+{
+  return frep::dot(frep::sub(b, a), frep::cross(frep::sub(c, a), frep::sub(d, a)));
 }
 
 void validateStructure(const TetMesh& mesh)
@@ -60,18 +67,8 @@ void validate(const TetMesh& mesh)
   for (std::size_t t = 0; t < mesh.tetrahedra.size(); ++t)
   {
     const auto& tet = mesh.tetrahedra[t];
-    const Point3& a = mesh.points[tet[0]];
-    double e[3][3];
-    for (int k = 0; k < 3; ++k)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        e[k][c] = mesh.points[tet[k + 1]][c] - a[c];
-      }
-    }
-    const double volume = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-      e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-      e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    const double volume = orientation(
+      mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]);
     if (!(volume > 0))
     {
       throw std::invalid_argument("tetrahedral mesh: tetrahedron " + std::to_string(t) +

@@ -61,6 +61,10 @@ struct TetraOptions
 /// (regular tetrahedra of edge `size`, volume size^3 / (6 sqrt 2)).
 double estimateTetrahedra(double volume, double size);
 
+/// 6 x the signed volume of (a, b, c, d), (b - a) . ((c - a) x (d - a)): positive for a
+/// positively oriented tetrahedron.
+double orientation(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+
 /// Checks indices, materials and the per-tetrahedron arrays; throws std::invalid_argument naming
 /// the first problem.
 void validateStructure(const TetMesh& mesh);

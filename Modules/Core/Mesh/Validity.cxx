@@ -35,16 +35,6 @@ using frep::distance;
 using frep::dot;
 using frep::sub;
 
-/// 6 x the signed volume of (a, b, c, d).
-double orient(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
-{
-  const double e[3][3] = { { b[0] - a[0], b[1] - a[1], b[2] - a[2] },
-    { c[0] - a[0], c[1] - a[1], c[2] - a[2] }, { d[0] - a[0], d[1] - a[1], d[2] - a[2] } };
-  return e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-    e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-    e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
-}
-
 std::string number(double v)
 {
   std::ostringstream s;
@@ -247,8 +237,8 @@ ValidityReport checkValidity(
     {
       shortest = std::min(shortest, distance(mesh.points[tet[e[0]]], mesh.points[tet[e[1]]]));
     }
-    const double volume =
-      orient(mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]) /
+    const double volume = orientation(mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]],
+                            mesh.points[tet[3]]) /
       6;
     if (shortest < r.minEdge)
     {
@@ -349,9 +339,9 @@ ValidityReport checkValidity(
       const Point3& a = mesh.points[f.v[0]];
       const Point3& b = mesh.points[f.v[1]];
       const Point3& c = mesh.points[f.v[2]];
-      const double s0 = orient(a, b, c, mesh.points[mesh.tetrahedra[f.tet][f.opposite]]);
+      const double s0 = orientation(a, b, c, mesh.points[mesh.tetrahedra[f.tet][f.opposite]]);
       const double s1 =
-        orient(a, b, c, mesh.points[mesh.tetrahedra[faces[i + 1].tet][faces[i + 1].opposite]]);
+        orientation(a, b, c, mesh.points[mesh.tetrahedra[faces[i + 1].tet][faces[i + 1].opposite]]);
       if (!(s0 * s1 < 0))
       {
         ++r.nonConformingFaces;

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Mesh/Writers.h"
 
-#include "Mesh/Validity.h"
-
 #include "Mesh/Quality.h"
 #include "Mesh/TetAttributes.h"
+#include "Mesh/Validity.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1377,13 +1377,8 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
       }
       tet[k] = i;
     }
-    const Point3 a = mesh.points[tet[0]];
-    const Point3 e1 = sub(mesh.points[tet[1]], a);
-    const Point3 e2 = sub(mesh.points[tet[2]], a);
-    const Point3 e3 = sub(mesh.points[tet[3]], a);
-    const double det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
-      e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) + e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
-    if (det < 0)
+    if (orientation(
+          mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]) < 0)
     {
       std::swap(tet[2], tet[3]);
     }
