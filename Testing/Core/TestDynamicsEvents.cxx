@@ -3,8 +3,8 @@
 // and locating transitions in time (root finding). Hand-derived values in the comments.
 
 #include "Dynamics/Events.h"
-#include "Dynamics/RootFinding.h"
 #include "Dynamics/Stepper.h"
+#include "FRep/RootFinding.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,6 +14,8 @@
 #include <cmath>
 
 using namespace ictk::dyn;
+using ictk::frep::Crossing;
+using ictk::frep::locateCrossing;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
