@@ -2,7 +2,8 @@
 // Whether two placed shapes share a point (intersects()) and whether one holds the other
 // (contains()).
 //
-// - Touching: intersects() is that same distance <= tolerance, and a tangency point of
+// - Touching: intersects() is the distance of Distance.cxx (separation) <= tolerance, and a
+// tangency point of
 //   intersectionPoints() is a first-order distance <= tolerance, which agree up to rounding and
 //   second-order terms (~gap^2 / radius): a pair intersects exactly when it has meeting points
 //   or one holds the other, as long as the distance finds the nearest pair, except for gaps
@@ -16,7 +17,7 @@
 //   (A's field values, not a distance), to ~1e-13 (measured on the egg in the liquid), when
 //   A's lowest point on B is in the basin of one of those descents; a local search, so likely
 //   rather than proved when fA has several minima on B.
-//   Tens of microseconds for small HyperFun fields (TestEngineShapes prints the figures).
+//   Tens of microseconds for small HyperFun fields (TestGeometry prints the figures).
 #include "Geometry/Prepared.h"
 #include "Geometry/Queries.h"
 

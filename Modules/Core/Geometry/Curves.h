@@ -101,7 +101,6 @@ struct Piece
 };
 
 Piece makeSegment(V2 p, V2 q);
-
 Piece makeEllipse(V2 c, V2 u, V2 v, double t0, double t1);
 
 /// The carrier of a piece (its line, circle or ellipse; the point itself), as a function that

@@ -24,6 +24,7 @@ namespace ictk::geometry::detail
 namespace
 {
 
+// Pasko's blending union, f1 + f2 + sqrt(f1^2 + f2^2) + a0 / (1 + f1^2 + f2^2) (a1 = a2 = 1):
 // an R-function union (its sign is the sign of max(f1, f2)) plus a bump of height a0 where both
 // fields are near 0, which fills the crease between the operands.
 double blendUnion(double f1, double f2, double a0)

@@ -12,6 +12,8 @@
 #include "FRep/Field.h"
 #include "FRep/Interval.h"
 
+#include <algorithm>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -69,32 +71,22 @@ inline Interval ivScale(double s, Interval a)
   return s >= 0 ? iv(s * a.lo, s * a.hi) : iv(s * a.hi, s * a.lo);
 }
 
-// Pasko's blending union, f1 + f2 + sqrt(f1^2 + f2^2) + a0 / (1 + f1^2 + f2^2) (a1 = a2 = 1):
-
 // ---------------------------------------------------------------------------------------------
 // Boxes (Prepared.cxx).
 
 double boxDiagonal(const Box3& b);
-
 Box3 joinBoxes(const Box3& a, const Box3& b);
-
 Box3 meetBoxes(const Box3& a, const Box3& b);
-
 Box3 flatten(Box3 b, bool flat);
-
 Box3 padded(Box3 b, double pad);
 
 // ---------------------------------------------------------------------------------------------
 // Placed shapes: dimensions, domains, checks (PlacedShape.cxx).
 
 int partDimension(const ShapePart& p);
-
 int shapeDimension(const PlacedShape& s);
-
 [[noreturn]] void fail(const PlacedShape& s, const std::string& what);
-
 [[noreturn]] void failPair(const PlacedShape& a, const PlacedShape& b, const std::string& what);
-
 bool finite3(const Vec3& v);
 
 /// A Field part's domain; an unset (empty) one is the [-10, 10]^3 that model files without
