@@ -11,6 +11,7 @@
 
 #include "FRep/Field.h"
 #include "FRep/Interval.h"
+#include "FRep/IntervalOps.h"
 
 #include <algorithm>
 #include <functional>
@@ -25,50 +26,41 @@ using frep::Box3;
 using frep::Interval;
 
 // ---------------------------------------------------------------------------------------------
-// Interval arithmetic for the analytic parts. Rounding is not directed here; the boxes pruned
-// with these bounds are never closer than a tolerance to a decision, so the last bits do not
-// matter (the tape fields round outward themselves).
+// Interval arithmetic for the analytic parts: the kernel's (FRep/IntervalOps.h, outward rounded
+// as the tape fields' own enclosures), under short names.
 
+/// The interval [lo, hi] (a box side, a constant).
 inline Interval iv(double lo, double hi)
 {
   return Interval{ lo, hi, false };
 }
 inline Interval ivAdd(Interval a, Interval b)
 {
-  return iv(a.lo + b.lo, a.hi + b.hi);
+  return frep::intervalOf(frep::Opcode::Add, a, b);
 }
 inline Interval ivNeg(Interval a)
 {
-  return iv(-a.hi, -a.lo);
+  return frep::intervalOf(frep::Opcode::Neg, a);
 }
 inline Interval ivMin(Interval a, Interval b)
 {
-  return iv(std::min(a.lo, b.lo), std::min(a.hi, b.hi));
+  return frep::intervalOf(frep::Opcode::Min, a, b);
 }
 inline Interval ivMax(Interval a, Interval b)
 {
-  return iv(std::max(a.lo, b.lo), std::max(a.hi, b.hi));
+  return frep::intervalOf(frep::Opcode::Max, a, b);
 }
 inline Interval ivAbs(Interval a)
 {
-  if (a.lo >= 0)
-  {
-    return a;
-  }
-  if (a.hi <= 0)
-  {
-    return ivNeg(a);
-  }
-  return iv(0, std::max(-a.lo, a.hi));
+  return frep::intervalOf(frep::Opcode::Abs, a);
 }
 inline Interval ivSquare(Interval a)
 {
-  const Interval m = ivAbs(a);
-  return iv(m.lo * m.lo, m.hi * m.hi);
+  return frep::intervalOf(frep::Opcode::Square, a);
 }
 inline Interval ivScale(double s, Interval a)
 {
-  return s >= 0 ? iv(s * a.lo, s * a.hi) : iv(s * a.hi, s * a.lo);
+  return frep::intervalOf(frep::Opcode::Mul, iv(s, s), a);
 }
 
 // ---------------------------------------------------------------------------------------------
