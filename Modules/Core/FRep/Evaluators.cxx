@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "FRep/Evaluators.h"
-#include "FRep/IntervalOps.h"
 
 #include "FRep/Kernels.h"
 #include "FRep/TapeDetail.h"
@@ -687,12 +686,6 @@ Interval intervalOp(
   }
 }
 } // namespace
-
-Interval intervalOf(Opcode op, const Interval& a, const Interval& b, const Interval& c)
-{
-  Choice unused;
-  return intervalOp(op, a, b, c, unused);
-}
 
 IntervalEvaluator::IntervalEvaluator(TapePtr tape, const std::vector<double>& parameters)
   : tape_(std::move(tape))
