@@ -17,6 +17,7 @@ namespace ictk::geometry::detail
 constexpr double Pi = 3.14159265358979323846;
 constexpr double Inf = std::numeric_limits<double>::infinity();
 
+/// A point or vector of the world plane.
 struct V2
 {
   double x = 0, y = 0;
@@ -54,6 +55,7 @@ inline Vec3 lift(V2 p)
   return { p.x, p.y, 0.0 };
 }
 
+/// One analytic curve of the world plane, parametrised by t in [lo(), hi()].
 struct Piece
 {
   enum class Type

@@ -9,10 +9,11 @@
 // rotation and scale, composed with its parents' under HIERARCHICAL dependencies). A 2D model
 // (cells of `dim = 2D` or less whose fields are functions of x[2]) lies in the plane z = 0.
 //
-// A placed shape is a value: the engine builds one per cell and instant. Its field
+// The engine (Engine/DynamicModel) builds a cell's placed shape at an instant; its field
 // (PlacedShape::value, worldField) is >= 0 inside, as every FRep field.
 
 #include "FRep/Field.h"
+#include "FRep/Vector.h"
 
 #include <array>
 #include <memory>
@@ -22,7 +23,8 @@
 namespace ictk::geometry
 {
 
-using Vec3 = std::array<double, 3>;
+/// A point or vector of the world: the kernel's (FRep/Vector.h).
+using Vec3 = frep::Point3;
 
 /// x -> A x + b.
 struct Affine
