@@ -22,6 +22,7 @@
 #include <cmath>
 
 using namespace ictk::dyn;
+using ictk::frep::locateCrossing;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 

@@ -123,7 +123,8 @@ std::size_t InstanceSet::activeAt(double t) const
 }
 
 std::vector<Transition> InstanceSet::trace(double t0, double t1, double dt,
-  const std::vector<std::function<double(double)>>& guards, const LocateOptions& options) const
+  const std::vector<std::function<double(double)>>& guards,
+  const frep::LocateOptions& options) const
 {
   if (!(dt > 0.0) || !(t1 >= t0))
     throw std::invalid_argument("InstanceSet::trace: need t1 >= t0 and dt > 0");
@@ -147,10 +148,10 @@ std::vector<Transition> InstanceSet::trace(double t0, double t1, double dt,
     double from = a;
     for (;;)
     {
-      std::optional<Crossing> first;
+      std::optional<frep::Crossing> first;
       for (const auto& g : guards)
       {
-        auto c = locateCrossing(g, from, b, options);
+        auto c = frep::locateCrossing(g, from, b, options);
         if (c && (!first || c->time < first->time))
           first = c;
       }

@@ -10,8 +10,8 @@
 // model state the caller binds into them.
 //
 // trace() walks [t0, t1] with step dt and records the transitions between instances with their
-// times. Instants where the structure changes are located with locateCrossing (RootFinding.h) on
-// the caller's guards (scalar state functions whose zeros are the structural events, e.g. the
+// times. Instants where the structure changes are located with locateCrossing (FRep/RootFinding.h)
+// on the caller's guards (scalar state functions whose zeros are the structural events, e.g. the
 // signed distance between two cells), so an instance valid only at an instant (a tangency) is
 // found and reported: the transition into it and the one out of it share the same time (within
 // the predicates' own tolerance). A change of the active instance that no guard explains is
@@ -20,8 +20,8 @@
 // a single instant), which is why the guards exist.
 #pragma once
 
-#include "Dynamics/RootFinding.h"
 #include "Dynamics/Time.h"
+#include "FRep/RootFinding.h"
 
 #include <functional>
 #include <optional>
@@ -95,7 +95,7 @@ public:
   /// time.
   std::vector<Transition> trace(double t0, double t1, double dt,
     const std::vector<std::function<double(double)>>& guards = {},
-    const LocateOptions& options = {}) const;
+    const frep::LocateOptions& options = {}) const;
 
 private:
   const IcTemplate* templateOf(const IcInstance& i) const;

@@ -4,6 +4,8 @@
 #include "Dynamics/Animation.h"
 #include "Dynamics/Stepper.h"
 #include "FRep/Tape.h"
+#include "Geometry/Queries.h"
+#include "Geometry/ShapeCells.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 
@@ -20,6 +22,12 @@
 namespace ictk::engine
 {
 
+using geometry::Affine;
+using geometry::PlacedShape;
+using geometry::PlacedShapePtr;
+using geometry::QueryOptions;
+using geometry::ShapePart;
+using geometry::Vec3;
 using lang::icm::CellDef;
 using lang::icm::Expr;
 using lang::icm::ExprPtr;
@@ -273,7 +281,7 @@ struct DynamicModel::Impl
   std::shared_ptr<const std::vector<ShapePart>> partsOf(const CellSpec& c) const;
   Affine localPlace(const std::string& cell) const;
   Affine place(const std::string& cell, int depth = 0) const;
-  ShapePtr shapeOf(const std::string& cell, int depth = 0) const;
+  PlacedShapePtr shapeOf(const std::string& cell, int depth = 0) const;
   std::uint64_t versionOf(const std::string& cell, int depth = 0) const;
   void bumpVersion(const std::string& cell) { s.versions[cell] = nextVersion++; }
 
@@ -316,7 +324,7 @@ private:
   /// The qualified parameter a bare name stands for, or "".
   std::string resolve(const std::string& name) const;
   const AliasSpec* alias(const std::string& name) const;
-  ShapePtr cellShape(const Value& v) const;
+  PlacedShapePtr cellShape(const Value& v) const;
 
   DynamicModel::Impl& m_;
   std::string cell_;
@@ -1321,12 +1329,12 @@ Affine DynamicModel::Impl::place(const std::string& cell, int depth) const
   return local;
 }
 
-ShapePtr DynamicModel::Impl::shapeOf(const std::string& cell, int depth) const
+PlacedShapePtr DynamicModel::Impl::shapeOf(const std::string& cell, int depth) const
 {
   if (depth > static_cast<int>(cells.size()))
     throw std::runtime_error("the shapes of blend/union cells refer to each other in a cycle");
   const CellSpec& c = cells[cellIndex.at(cell)];
-  auto shape = std::make_shared<Shape>();
+  auto shape = std::make_shared<PlacedShape>();
   shape->cell = c.name;
   shape->dimension = c.dimension;
   shape->place = place(cell);
@@ -1731,7 +1739,7 @@ bool EngineScope::assign(const std::string& name, const std::string& member, con
   return false;
 }
 
-ShapePtr EngineScope::cellShape(const Value& v) const
+PlacedShapePtr EngineScope::cellShape(const Value& v) const
 {
   if (v.type != Value::Type::Cell)
     throw std::runtime_error(std::string("expected a cell, got a ") + typeName(v.type));
@@ -1745,11 +1753,11 @@ Value EngineScope::call(const std::string& name, const std::vector<Value>& args)
 {
   const QueryOptions& q = m_.options.geometry;
   if (name == "distance")
-    return Value::real(engine::distance(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
+    return Value::real(geometry::distance(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
   if (name == "intersects")
-    return Value::boolean(engine::intersects(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
+    return Value::boolean(geometry::intersects(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
   if (name == "contains")
-    return Value::boolean(engine::contains(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
+    return Value::boolean(geometry::contains(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
   if (name == "intersectionCount")
     return Value::integer(static_cast<double>(
       intersectionPoints(*cellShape(args.at(0)), *cellShape(args.at(1)), q).size()));
@@ -2136,7 +2144,7 @@ complex::Complex DynamicModel::complex() const
     auto a = m.attributes.find(name);
     if (a == m.attributes.end() || !a->second.tape || !ids.count(cell))
       continue;
-    Shape local;
+    PlacedShape local;
     local.cell = cell;
     local.dimension = 3;
     local.place = m.place(cell);
