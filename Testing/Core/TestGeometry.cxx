@@ -2,6 +2,7 @@
 #include "Geometry/PlacedShape.h"
 #include "Geometry/Queries.h"
 #include "Geometry/ShapeCells.h"
+#include "GeometryTestShapes.h"
 
 #include "Complex/Cell.h"
 #include "FRep/Expr.h"
@@ -9,7 +10,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -23,105 +23,17 @@ using geometry::Affine;
 using geometry::PlacedShape;
 using geometry::ShapePart;
 using geometry::Vec3;
+using namespace geometry::testing;
 
 constexpr double Pi = 3.14159265358979323846;
 // r^2 acos(d / r) - d sqrt(r^2 - d^2) for r = 1, d = 0.5: acos(0.5) = pi / 3, sqrt(0.75).
 const double SegmentArea = Pi / 3 - 0.5 * std::sqrt(0.75); // 0.6141848493...
-
-Affine at(double x, double y, double z = 0)
-{
-  return Affine::fromTransform({ x, y, z }, { 0, 0, 0 }, { 1, 1, 1 });
-}
-
-PlacedShape shapeOf(
-  const std::string& name, int dimension, ShapePart part, const Affine& place = {})
-{
-  PlacedShape s;
-  s.cell = name;
-  s.dimension = dimension;
-  s.parts.push_back(std::move(part));
-  s.place = place;
-  return s;
-}
-
-PlacedShape disk(double r, const Affine& place, const std::string& name = "disk")
-{
-  ShapePart p;
-  p.kind = ShapePart::Kind::Disk;
-  p.radius = r;
-  return shapeOf(name, 2, p, place);
-}
-
-PlacedShape rectangle(
-  double w, double h, const Affine& place, const std::string& name = "rectangle")
-{
-  ShapePart p;
-  p.kind = ShapePart::Kind::Rectangle;
-  p.size = { w, h, 0 };
-  return shapeOf(name, 2, p, place);
-}
-
-PlacedShape segment(const Vec3& a, const Vec3& b, const std::string& name = "segment")
-{
-  ShapePart p;
-  p.kind = ShapePart::Kind::Segment;
-  p.points = { a, b };
-  return shapeOf(name, 1, p);
-}
-
-PlacedShape sphere(double r, const Affine& place, const std::string& name = "sphere")
-{
-  ShapePart p;
-  p.kind = ShapePart::Kind::Sphere;
-  p.radius = r;
-  return shapeOf(name, 3, p, place);
-}
-
-frep::FieldPtr fieldOf(const frep::Expr& e)
-{
-  return frep::tapeField(frep::Tape::compile(e));
-}
-
-/// The HyperFun-style disk r^2 - x^2 - y^2 (not a distance) as a 2D Field part.
-PlacedShape fieldDisk(double r, const Affine& place, const std::string& name = "fieldDisk")
-{
-  using frep::Expr;
-  ShapePart p;
-  p.kind = ShapePart::Kind::Field;
-  p.fieldDimension = 2;
-  p.field = fieldOf(r * r - Expr::x() * Expr::x() - Expr::y() * Expr::y());
-  p.bounds = { { -1.5 * r, -1.5 * r, 0 }, { 1.5 * r, 1.5 * r, 0 } };
-  return shapeOf(name, 2, p, place);
-}
-
-PlacedShape fieldSphere(double r, const Affine& place, const std::string& name = "fieldSphere")
-{
-  using frep::Expr;
-  ShapePart p;
-  p.kind = ShapePart::Kind::Field;
-  p.fieldDimension = 3;
-  p.field = fieldOf(r * r - Expr::x() * Expr::x() - Expr::y() * Expr::y() - Expr::z() * Expr::z());
-  p.bounds = { { -2 * r, -2 * r, -2 * r }, { 2 * r, 2 * r, 2 * r } };
-  return shapeOf(name, 3, p, place);
-}
 
 void expectPoint(const Vec3& p, double x, double y, double tol)
 {
   EXPECT_NEAR(p[0], x, tol);
   EXPECT_NEAR(p[1], y, tol);
   EXPECT_NEAR(p[2], 0.0, tol);
-}
-
-template <class F>
-double microseconds(int repeats, const F& f)
-{
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < repeats; ++i)
-  {
-    f();
-  }
-  const auto t1 = std::chrono::steady_clock::now();
-  return std::chrono::duration<double, std::micro>(t1 - t0).count() / repeats;
 }
 
 } // namespace
@@ -505,36 +417,6 @@ TEST(GeometryShapes, Errors)
   EXPECT_THROW(geometry::measure(segment({ 0, 0, 0 }, { 1, 0, 0 })), std::invalid_argument);
 }
 
-TEST(GeometryShapes, Timings)
-{
-  // Not a benchmark: a guard that the queries stay in their budget (microseconds for analytic
-  // shapes, well below 10 ms for small fields), and the numbers for the report.
-  const PlacedShape d = disk(1, at(1 + 1e-3, 0));
-  const PlacedShape w = rectangle(2, 2, at(3, 0));
-  const PlacedShape fd = fieldDisk(1, at(1 + 1e-3, 0));
-  const double pointsAnalytic = microseconds(200, [&] { geometry::intersectionPoints(d, w); });
-  const double distanceAnalytic = microseconds(200, [&] { geometry::distance(d, w); });
-  const double areaAnalytic = microseconds(200, [&] { geometry::intersectionMeasure(d, w); });
-  const double pointsField = microseconds(20, [&] { geometry::intersectionPoints(fd, w); });
-  const double intersectsField = microseconds(20, [&] { geometry::intersects(fd, w); });
-  const double fieldField = microseconds(
-    5, [&] { geometry::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(1, 0))); });
-  const double distanceSpheres = microseconds(20,
-    [&]
-    { geometry::distance(fieldSphere(0.5, at(-0.75, 0, 0)), fieldSphere(0.5, at(0.75, 0, 0))); });
-  const double containsField =
-    microseconds(5, [&] { geometry::contains(fieldDisk(1, {}), fieldDisk(0.5, at(0.4, 0))); });
-  const double areaField = microseconds(5, [&] { geometry::intersectionMeasure(fd, w); });
-  std::printf("intersectionPoints disk/rectangle %.1f us, distance %.1f us, area %.1f us\n",
-    pointsAnalytic, distanceAnalytic, areaAnalytic);
-  std::printf("field disk/rectangle: points %.1f us, intersects %.1f us, area %.1f us\n",
-    pointsField, intersectsField, areaField);
-  std::printf("field/field points %.1f us, field spheres distance %.1f us, contains %.1f us\n",
-    fieldField, distanceSpheres, containsField);
-  EXPECT_LT(pointsAnalytic, 1000);
-  EXPECT_LT(pointsField, 20000);
-}
-
 // Data/Models/icm/ch5_1_disk_rectangle.icm: DEQS = rectangle(2, 4) at (3, 0), so x in [2, 4]
 // and y in [-2, 2]; LHKF = the HyperFun disk 1 - x^2 - y^2 on the domain [-1, 1]^2, moving
 // along x. The domain clips the field exactly at the disk's box.
@@ -615,16 +497,6 @@ TEST(GeometryShapes, EggAndLiquidModel)
   // Half submerged at -3.2: half the ellipsoid's 4/3 pi 0.5 0.7 0.5.
   EXPECT_NEAR(geometry::intersectionMeasure(pool, egg(-3.2)), 2.0 / 3 * Pi * 0.5 * 0.7 * 0.5,
     2e-4 * Pi * 0.5 * 0.7 * 0.5);
-  const double volume = microseconds(1, [&] { geometry::intersectionMeasure(pool, egg(-3.2)); });
-  std::printf("egg/liquid volume %.1f us\n", volume);
-  const double t = microseconds(5,
-    [&]
-    {
-      geometry::distance(pool, egg(-2));
-      geometry::intersects(pool, egg(-2));
-      geometry::contains(pool, egg(-4));
-    });
-  std::printf("egg/liquid distance + intersects + contains %.1f us\n", t);
 }
 
 // The disk of DiskThroughRectangleModel swept in steps of 0.01: the count of meeting points is
@@ -867,10 +739,5 @@ TEST(GeometryShapes, ContainsFlipsAtTheExactPlacement)
       exact, lo - exact, tol, lo - exact - tol);
     EXPECT_NEAR(lo - exact, tol, 1e-12);
     EXPECT_NEAR(lo, exact, 1e-6);
-    const double us = microseconds(20, [&] { geometry::contains(pool, egg(exact - 1e-7)); });
-    const double usOut = microseconds(20, [&] { geometry::contains(pool, egg(exact + 1e-7)); });
-    std::printf("contains near the flip: %.1f us (inside), %.1f us (outside)\n", us, usOut);
-    EXPECT_LT(us, 1000);
-    EXPECT_LT(usOut, 1000);
   }
 }
