@@ -7,6 +7,7 @@
 #include "Lang/ComplexFile.h"
 #include "Lang/ModelFile.h"
 #include "ictkComplexSource.h"
+#include "ictkComplexToVTK.h"
 
 #include <nlohmann/json.hpp>
 
@@ -342,7 +343,7 @@ int RunComplexMesh(const ComplexOptions& o)
   else
   {
     vtkNew<vtkMultiBlockDataSet> blocks;
-    ictkComplexSource::ToMultiBlock(pdc, blocks);
+    ictk::vtk::complexToMultiBlock(pdc, blocks);
     vtkNew<vtkXMLMultiBlockDataWriter> writer;
     WriteComposite(writer, blocks, o.Output);
   }
