@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkTimeSeriesWriter.h"
 #include "ictkComplexSource.h"
+#include "ictkRequest.h"
 
 #include "vtkAbstractArray.h"
 #include "vtkAlgorithmOutput.h"
@@ -34,7 +35,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
-#include <new>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -286,19 +286,8 @@ int ictkTimeSeriesWriter::Write()
   this->FramesWritten = 0;
   this->InvokeEvent(vtkCommand::StartEvent);
   this->UpdateProgress(0.0);
-  int result = 0;
-  try
-  {
-    result = this->WriteSeries();
-  }
-  catch (const std::bad_alloc&)
-  {
-    vtkErrorMacro("out of memory");
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro("" << e.what());
-  }
+  // WriteSeries() meets a cancellation between frames and returns 0; runRequest reports its errors.
+  const int result = ictk::vtk::runRequest(this, nullptr, [this] { return this->WriteSeries(); });
   if (!result)
   {
     this->FramesWritten = 0;
