@@ -11,6 +11,7 @@
 #include "VtkMessages.h"
 
 #include "ictkComplexSource.h"
+#include "ictkComplexToVTK.h"
 
 #include <vtkCallbackCommand.h>
 #include <vtkCommand.h>
@@ -130,7 +131,7 @@ private:
     else
     {
       vtkNew<vtkMultiBlockDataSet> blocks;
-      ictkComplexSource::ToMultiBlock(pdc, blocks);
+      ictk::vtk::complexToMultiBlock(pdc, blocks);
       vtkNew<vtkXMLMultiBlockDataWriter> writer;
       WriteComposite(writer, blocks, o.Output);
     }

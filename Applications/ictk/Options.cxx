@@ -3,6 +3,8 @@
 
 #include "Command.h"
 
+#include "Engine/FrameSequence.h"
+
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -17,9 +19,6 @@ namespace ictk::cli
 {
 namespace
 {
-
-/// More frames than anyone can look at; a spec asking for them is a typo (a missing digit in DT).
-constexpr double MaxFrames = 1e6;
 
 /// Parses one number; `what` names it in the messages ("--at: field 'x'", "--frames: T0") and
 /// `context` is added to the "not a number" one (the whole value, where the field alone is not
@@ -204,31 +203,15 @@ std::vector<double> ParseFrames(const std::string& spec, const std::string& opti
   {
     throw UserError(option + ": DT must be positive, got '" + fields[2] + "'");
   }
-  const double count = std::floor((t1 - t0) / dt + 1e-3);
-  if (!(count + 1 <= MaxFrames))
+  const double count = engine::frameCount(t0, t1, dt);
+  if (!(count <= engine::MaxFrames))
   {
     std::ostringstream os;
-    os << option << ": '" << spec << "' gives " << std::setprecision(3) << count + 1
+    os << option << ": '" << spec << "' gives " << std::setprecision(3) << count
        << " frames, more than the limit of 1000000 (a larger DT?)";
     throw UserError(os.str());
   }
-  std::vector<double> times;
-  const auto n = static_cast<long long>(count);
-  times.reserve(static_cast<std::size_t>(n + 2));
-  for (long long k = 0; k <= n; ++k)
-  {
-    // By multiplication, not accumulation: frame k is at T0 + k DT to the last bit.
-    times.push_back(t0 + static_cast<double>(k) * dt);
-  }
-  if (std::abs(t1 - times.back()) < 1e-3 * dt)
-  {
-    times.back() = t1;
-  }
-  else if (times.back() < t1)
-  {
-    times.push_back(t1);
-  }
-  return times;
+  return engine::frameTimes(t0, t1, dt);
 }
 
 bool HasExtension(const std::string& path, const std::string& extension)

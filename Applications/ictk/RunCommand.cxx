@@ -1,21 +1,23 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `ictk run`: runs a dynamic implicit complex (.icm) over a range of times and writes a .pvd time
 // series of its discretised complexes (one .vtpc per frame), optionally with a JSON-lines trace
-// of every evaluated time.
+// of every evaluated time. The run is the dynamic complex source written by the time series
+// writer (Engine/FrameSequence.h is their one frame loop); this file adds the trace, the progress
+// display, Ctrl-C and the summary.
 #include "Command.h"
 #include "Options.h"
 #include "Progress.h"
 
-#include "Engine/CoherentDiscretizer.h"
 #include "Engine/DynamicModel.h"
-#include "FRep/Sampling.h"
+#include "Engine/FrameSequence.h"
 #include "Lang/Diagnostics.h"
-#include "ictkComplexSource.h"
 #include "ictkDynamicComplexSource.h"
+#include "ictkTimeSeriesWriter.h"
 
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
+#include <vtkExecutive.h>
 #include <vtkNew.h>
-#include <vtkPartitionedDataSetCollection.h>
-#include <vtkXMLPartitionedDataSetCollectionWriter.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -23,13 +25,15 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <initializer_list>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -90,171 +94,95 @@ std::string TraceLine(const engine::FrameRecord& r)
   return line + "}}";
 }
 
-/// The frames folder's entries this command writes: <stem>_<digits>.vtpc and their pieces
-/// folders <stem>_<digits>.
-bool IsFrameEntry(const fs::directory_entry& entry, const std::string& stem)
+/// The trace's destination, checked before any work, and the temporary file beside it that it is
+/// written to; moved into place only once the series is written, removed otherwise.
+struct TraceFile
 {
-  std::string name = entry.path().filename().string();
-  const std::string prefix = stem + "_";
-  if (name.rfind(prefix, 0) != 0)
-  {
-    return false;
-  }
-  name = name.substr(prefix.size());
-  if (entry.is_regular_file() && HasExtension(name, ".vtpc"))
-  {
-    name = name.substr(0, name.size() - 5);
-  }
-  else if (!entry.is_directory())
-  {
-    return false;
-  }
-  return !name.empty() &&
-    std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isdigit(c); });
-}
-
-/// Where the outputs go, checked before any work: the .pvd, its frames folder (named after its
-/// stem, beside it) and the trace. Everything is written into a staging folder beside the .pvd
-/// and moved into place at the end, so that an error or Ctrl-C leaves what was there untouched.
-struct Outputs
-{
-  fs::path Pvd;
-  fs::path Frames; ///< the frames folder
-  std::string Stem;
-  fs::path Staging;
   fs::path Trace;
-  fs::path TraceTemporary;
+  fs::path Temporary;
+  std::ofstream Stream;
   bool Committed = false;
 
-  Outputs(const std::string& output, const std::string& trace)
+  explicit TraceFile(const std::string& trace)
   {
-    if (!HasExtension(output, ".pvd"))
+    if (trace.empty())
     {
-      throw std::invalid_argument("-o: '" + output + "' is not a .pvd file");
+      return;
     }
-    Pvd = fs::absolute(output);
-    Stem = Pvd.stem().string();
-    Frames = Pvd.parent_path() / Stem;
+    Trace = fs::absolute(trace);
     std::error_code ec;
-    if (!fs::is_directory(Pvd.parent_path(), ec))
+    if (fs::is_directory(Trace, ec))
     {
-      throw std::invalid_argument("cannot write '" + output + "': folder '" +
-        Pvd.parent_path().string() + "' does not exist");
+      throw std::invalid_argument("--trace: cannot write '" + trace + "': it is a directory");
     }
-    if (fs::is_directory(Pvd, ec))
+    if (!fs::is_directory(Trace.parent_path(), ec))
     {
-      throw std::invalid_argument("cannot write '" + output + "': it is a directory");
+      throw std::invalid_argument("--trace: cannot write '" + trace + "': folder '" +
+        Trace.parent_path().string() + "' does not exist");
     }
-    if (fs::exists(Frames, ec))
-    {
-      if (!fs::is_directory(Frames, ec))
-      {
-        throw std::invalid_argument("cannot write the frames of '" + output + "': '" +
-          Frames.string() + "' is a file; move it or choose another name");
-      }
-      // Replace an earlier run's frames, never anything else.
-      for (const auto& entry : fs::directory_iterator(Frames))
-      {
-        if (!IsFrameEntry(entry, Stem))
-        {
-          throw std::invalid_argument("cannot write the frames of '" + output + "': the folder '" +
-            Frames.string() + "' holds other files ('" + entry.path().filename().string() +
-            "'); move them or choose another name");
-        }
-      }
-    }
-    if (!trace.empty())
-    {
-      Trace = fs::absolute(trace);
-      if (fs::is_directory(Trace, ec))
-      {
-        throw std::invalid_argument("--trace: cannot write '" + trace + "': it is a directory");
-      }
-      if (!fs::is_directory(Trace.parent_path(), ec))
-      {
-        throw std::invalid_argument("--trace: cannot write '" + trace + "': folder '" +
-          Trace.parent_path().string() + "' does not exist");
-      }
-      TraceTemporary = Trace.parent_path() /
-        ("." + Trace.filename().string() + ".ictk-" + std::to_string(::getpid()));
-    }
-    Staging = Pvd.parent_path() / (".ictk-run-" + Stem + "-" + std::to_string(::getpid()));
-    fs::remove_all(Staging, ec);
-    if (!fs::create_directory(Staging, ec) || !fs::create_directory(Staging / Stem, ec))
-    {
-      const std::string why = ec.message();
-      fs::remove_all(Staging, ec);
-      throw std::invalid_argument("cannot write '" + output + "': " + why);
-    }
+    Temporary = Trace.parent_path() /
+      ("." + Trace.filename().string() + ".ictk-" + std::to_string(::getpid()));
   }
-  Outputs(const Outputs&) = delete;
-  Outputs& operator=(const Outputs&) = delete;
-  ~Outputs()
+  TraceFile(const TraceFile&) = delete;
+  TraceFile& operator=(const TraceFile&) = delete;
+  ~TraceFile()
   {
-    std::error_code ec;
-    fs::remove_all(Staging, ec);
-    if (!Committed && !TraceTemporary.empty())
+    if (!Committed && !Temporary.empty())
     {
-      fs::remove(TraceTemporary, ec);
+      Stream.close();
+      std::error_code ec;
+      fs::remove(Temporary, ec);
     }
   }
-
-  /// Moves everything into place; an earlier run's frames are replaced only once the new ones
-  /// are there to take their place.
-  void commit()
-  {
-    const fs::path old = Staging / ".previous";
-    const bool hadFrames = fs::exists(Frames);
-    if (hadFrames)
-    {
-      fs::rename(Frames, old);
-    }
-    try
-    {
-      fs::rename(Staging / Stem, Frames);
-    }
-    catch (...)
-    {
-      if (hadFrames)
-      {
-        std::error_code ec;
-        fs::rename(old, Frames, ec);
-      }
-      throw;
-    }
-    fs::rename(Staging / (Stem + ".pvd"), Pvd);
-    if (!TraceTemporary.empty())
-    {
-      fs::rename(TraceTemporary, Trace);
-    }
-    Committed = true;
-  }
+  bool enabled() const { return !Temporary.empty(); }
 };
 
-std::string XmlAttribute(const std::string& s)
+/// Calls `f(event, callData)` on events of a VTK object for as long as it lives.
+class Observer
 {
-  std::string out;
-  for (char c : s)
+public:
+  using Function = std::function<void(unsigned long, void*)>;
+  Observer(vtkObject* object, std::initializer_list<unsigned long> events, Function f)
+    : object_(object)
+    , f_(std::make_unique<Function>(std::move(f)))
   {
-    switch (c)
+    command_->SetClientData(f_.get());
+    command_->SetCallback([](vtkObject*, unsigned long event, void* clientData, void* callData)
+      { (*static_cast<Function*>(clientData))(event, callData); });
+    for (unsigned long event : events)
     {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
+      tags_.push_back(object->AddObserver(event, command_));
     }
   }
-  return out;
+  ~Observer()
+  {
+    for (unsigned long tag : tags_)
+    {
+      object_->RemoveObserver(tag);
+    }
+  }
+  Observer(const Observer&) = delete;
+  Observer& operator=(const Observer&) = delete;
+
+private:
+  vtkObject* object_;
+  std::unique_ptr<Function> f_;
+  vtkNew<vtkCallbackCommand> command_;
+  std::vector<unsigned long> tags_;
+};
+
+/// The text of a VTK error event: "ERROR: In file.cxx, line N\nclass (0x...): message" ->
+/// "message".
+std::string VtkErrorText(const char* event)
+{
+  std::string text = event ? event : "";
+  const auto at = text.find("): ");
+  if (at != std::string::npos)
+  {
+    text = text.substr(at + 3);
+  }
+  text.erase(text.find_last_not_of(" \t\r\n") + 1);
+  return text;
 }
 
 struct Transition
@@ -279,242 +207,260 @@ int RunModel(const RunModelOptions& o)
   {
     throw std::invalid_argument("'" + o.Model + "' is not a .icm model");
   }
-  // Fail on an unwritable destination before spending time on the run.
-  Outputs out(o.Output, o.Trace);
+  if (!HasExtension(o.Output, ".pvd"))
+  {
+    throw std::invalid_argument("-o: '" + o.Output + "' is not a .pvd file");
+  }
+  TraceFile trace(o.Trace);
   const auto started = Clock::now();
+  const double maxStep = o.MaxStep > 0 ? o.MaxStep : times.size() > 1 ? times[1] - times[0] : 1.0;
 
-  ProgressBar bar("run", false, !o.Json);
-  std::size_t frame = 0;
-  auto frameOf = [&]
+  // The run is the dynamic complex source (the engine's frames) written by the time series
+  // writer; this command adds the trace, the progress display, Ctrl-C and the summary.
+  vtkNew<ictkDynamicComplexSource> source;
+  source->SetFileName(o.Model.c_str());
+  source->SetTimeSteps(times.data(), static_cast<int>(times.size()));
+  source->SetMaximumStep(maxStep);
+  source->SetFeatureSize(o.FeatureSize);
+  source->SetCoherent(!o.NoCoherence);
+  source->SetNumberOfThreads(o.Threads);
+  vtkNew<ictkTimeSeriesWriter> writer;
+  writer->SetInputConnection(source->GetOutputPort());
+  writer->SetFileName(o.Output.c_str());
+
+  // VTK's errors become this command's (the first one, kept rather than printed).
+  std::string failure;
+  auto onError = [&](unsigned long, void* callData)
   {
-    return "frame " + std::to_string(frame + 1) + "/" + std::to_string(times.size());
+    if (failure.empty())
+    {
+      failure = VtkErrorText(static_cast<const char*>(callData));
+    }
   };
-  engine::RunOptions runOptions;
-  runOptions.progress = [&](double fraction)
+  const Observer errors[] = { { source, { vtkCommand::ErrorEvent }, onError },
+    { source->GetExecutive(), { vtkCommand::ErrorEvent }, onError },
+    { writer, { vtkCommand::ErrorEvent }, onError },
+    { writer->GetExecutive(), { vtkCommand::ErrorEvent }, onError } };
+  // A model error in the front ends' form, with the source line and a caret.
+  auto rethrowModelError = [&]
   {
-    bar.Show((double(frame) + 0.5 * fraction) / double(times.size()), frameOf());
-    return !Interrupted();
-  };
-  engine::CoherenceOptions meshOptions;
-  meshOptions.featureSize = o.FeatureSize;
-  meshOptions.coherent = !o.NoCoherence;
-  meshOptions.threads = o.Threads;
-  meshOptions.progress = [&](double fraction)
-  {
-    bar.Show((double(frame) + 0.5 + 0.5 * fraction) / double(times.size()), frameOf());
-    return !Interrupted();
+    if (const std::exception_ptr e = source->GetLastError())
+    {
+      try
+      {
+        std::rethrow_exception(e);
+      }
+      catch (const engine::ModelError& m)
+      {
+        throw AsParseError(m);
+      }
+    }
   };
 
   InterruptScope interrupts;
-  try
+  const auto loadStart = Clock::now();
+  source->UpdateInformation();
+  rethrowModelError();
+  if (!failure.empty())
   {
-    auto loadStart = Clock::now();
-    engine::DynamicModel model = [&]
-    {
-      try
-      {
-        return engine::DynamicModel::load(o.Model, runOptions);
-      }
-      catch (const engine::ModelError& e)
-      {
-        throw AsParseError(e);
-      }
-    }();
-    const double maxStep = o.MaxStep > 0 ? o.MaxStep : times.size() > 1 ? times[1] - times[0] : 1.0;
-    std::ofstream trace;
-    if (!out.TraceTemporary.empty())
-    {
-      trace.open(out.TraceTemporary, std::ios::binary);
-      if (!trace)
-      {
-        throw std::invalid_argument("--trace: cannot write '" + o.Trace + "'");
-      }
-    }
+    throw std::runtime_error(failure);
+  }
+  if (times.front() < source->GetStartTime())
+  {
+    std::ostringstream os;
+    os << o.FramesOption << ": T0 = " << times.front() << " is before the model's start ("
+       << source->GetStartTime() << ")";
+    throw std::invalid_argument(os.str());
+  }
+  double engineSeconds = Seconds(loadStart), meshSeconds = 0;
+
+  // Every frame the source computes: its share of the progress (engine, then meshing, as the
+  // source reports them), its timing, and its records for the trace and the summary.
+  ProgressBar bar("run", false, !o.Json);
+  struct Run
+  {
+    std::size_t frame = 0;
+    Clock::time_point start;
+    Clock::time_point meshStart;
+    bool meshing = false;
     std::size_t records = 0;
     std::vector<Transition> transitions;
     std::string instance;
-    auto record = [&](const engine::FrameRecord& r)
+    std::string traceError;
+  } run;
+  if (trace.enabled())
+  {
+    trace.Stream.open(trace.Temporary, std::ios::binary);
+    if (!trace.Stream)
     {
-      if (trace.is_open())
-      {
-        trace << TraceLine(r) << "\n";
-      }
-      ++records;
-      if (!instance.empty() && r.instance != instance)
-      {
-        transitions.push_back({ r.time, instance, r.instance });
-      }
-      instance = r.instance;
-    };
-    double engineSeconds = 0, meshSeconds = 0, writeSeconds = 0;
-    engine::CoherentDiscretizer mesher(meshOptions);
-    try
-    {
-      record(model.start());
-      if (times.front() < model.time())
-      {
-        std::ostringstream os;
-        os << o.FramesOption << ": T0 = " << times.front() << " is before the model's start ("
-           << model.time() << ")";
-        throw std::invalid_argument(os.str());
-      }
-      if (!(o.FeatureSize > 0))
-      {
-        // From the model's start, so that the same model gives the same meshes whatever T0.
-        mesher.setFeatureSize(complex::defaultFeatureSize(model.complex()));
-      }
+      throw std::invalid_argument("--trace: cannot write '" + o.Trace + "'");
     }
-    catch (const engine::ModelError& e)
+  }
+  auto cancelIfInterrupted = [&]
+  {
+    if (Interrupted() || !run.traceError.empty())
     {
-      throw AsParseError(e);
+      source->SetAbortExecute(1);
+      writer->SetAbortExecute(1);
     }
-    engineSeconds += Seconds(loadStart);
+  };
+  auto onStart = [&]
+  {
+    run.start = Clock::now();
+    run.meshing = false;
+  };
+  auto onProgress = [&](double fraction)
+  {
+    if (!run.meshing && fraction >= 0.5)
+    {
+      run.meshStart = Clock::now();
+      run.meshing = true;
+    }
+    bar.Show((double(run.frame) + fraction) / double(times.size()),
+      "frame " + std::to_string(run.frame + 1) + "/" + std::to_string(times.size()));
+    cancelIfInterrupted();
+  };
+  auto onEnd = [&]
+  {
+    const auto now = Clock::now();
+    engineSeconds +=
+      std::chrono::duration<double>((run.meshing ? run.meshStart : now) - run.start).count();
+    meshSeconds += run.meshing ? std::chrono::duration<double>(now - run.meshStart).count() : 0;
+    for (const engine::FrameRecord& r : source->GetFrameRecords())
+    {
+      if (trace.Stream.is_open())
+      {
+        trace.Stream << TraceLine(r) << "\n";
+      }
+      ++run.records;
+      if (!run.instance.empty() && r.instance != run.instance)
+      {
+        run.transitions.push_back({ r.time, run.instance, r.instance });
+      }
+      run.instance = r.instance;
+    }
+    ++run.frame;
+    if (trace.Stream.is_open() && run.frame == times.size())
+    {
+      trace.Stream.close();
+    }
+    if (trace.enabled() && !trace.Stream)
+    {
+      run.traceError = "--trace: cannot write '" + o.Trace + "'";
+    }
+    cancelIfInterrupted();
+  };
+  const Observer sourceEvents(source,
+    { vtkCommand::StartEvent, vtkCommand::ProgressEvent, vtkCommand::EndEvent },
+    [&](unsigned long event, void* callData)
+    {
+      if (event == vtkCommand::StartEvent)
+      {
+        onStart();
+      }
+      else if (event == vtkCommand::ProgressEvent)
+      {
+        onProgress(*static_cast<double*>(callData));
+      }
+      else
+      {
+        onEnd();
+      }
+    });
+  const Observer writerEvents(
+    writer, { vtkCommand::ProgressEvent }, [&](unsigned long, void*) { cancelIfInterrupted(); });
 
-    const std::size_t digits = std::max<std::size_t>(4, std::to_string(times.size() - 1).size());
-    std::ostringstream pvd;
-    pvd << "<?xml version=\"1.0\"?>\n"
-        << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-        << "  <Collection>\n";
-    vtkNew<vtkXMLPartitionedDataSetCollectionWriter> writer;
-    // Raw appended data with LZ4: writing a frame should not cost more than computing it.
-    writer->SetDataModeToAppended();
-    writer->EncodeAppendedDataOff();
-    writer->SetCompressorTypeToLZ4();
-    for (frame = 0; frame < times.size(); ++frame)
+  const auto writeStart = Clock::now();
+  const double computedBefore = engineSeconds + meshSeconds;
+  const int written = writer->Write();
+  bar.End();
+  const double writeSeconds =
+    std::max(0.0, Seconds(writeStart) - (engineSeconds + meshSeconds - computedBefore));
+  if (!written)
+  {
+    if (!run.traceError.empty())
     {
-      const double t = times[frame];
-      auto t0 = Clock::now();
-      try
-      {
-        if (t > model.time())
-        {
-          for (const engine::FrameRecord& r : model.advanceTo(t, maxStep))
-          {
-            record(r);
-          }
-        }
-        engineSeconds += Seconds(t0);
-        t0 = Clock::now();
-        const std::vector<engine::CellState> cells = model.cells();
-        const ictk::complex::Complex k = model.complex();
-        const ictk::complex::ComplexMesh mesh = mesher.discretize(cells, k);
-        vtkNew<vtkPartitionedDataSetCollection> collection;
-        ictkComplexSource::Convert(k, mesh, collection);
-        ictkDynamicComplexSource::AddFrameFields(collection, model.activeInstance().c_str(), t);
-        meshSeconds += Seconds(t0);
-
-        t0 = Clock::now();
-        std::ostringstream name;
-        name << out.Stem << "_" << std::setw(static_cast<int>(digits)) << std::setfill('0') << frame
-             << ".vtpc";
-        writer->SetInputDataObject(collection);
-        writer->SetFileName((out.Staging / out.Stem / name.str()).string().c_str());
-        if (writer->Write() != 1 || writer->GetErrorCode() != 0)
-        {
-          throw std::runtime_error(
-            "cannot write frame " + std::to_string(frame) + " of '" + o.Output + "'");
-        }
-        writeSeconds += Seconds(t0);
-        pvd << "    <DataSet timestep=\"" << nlohmann::json(t).dump() << "\" file=\""
-            << XmlAttribute(out.Stem + "/" + name.str()) << "\"/>\n";
-      }
-      catch (const engine::ModelError& e)
-      {
-        throw AsParseError(e);
-      }
+      throw std::runtime_error(run.traceError);
     }
-    bar.End();
-    pvd << "  </Collection>\n</VTKFile>\n";
+    if (Interrupted())
     {
-      std::ofstream file(out.Staging / (out.Stem + ".pvd"), std::ios::binary);
-      file << pvd.str();
-      if (!file.flush())
-      {
-        throw std::runtime_error("cannot write '" + o.Output + "'");
-      }
+      std::cerr << "ictk: interrupted; nothing written\n";
+      return ExitInterrupted;
     }
-    if (trace.is_open())
-    {
-      trace.close();
-      if (!trace)
-      {
-        throw std::runtime_error("--trace: cannot write '" + o.Trace + "'");
-      }
-    }
-    out.commit();
-    const double seconds = Seconds(started);
-
-    const engine::CoherenceStats& stats = mesher.total();
-    if (o.Json)
-    {
-      nlohmann::ordered_json j;
-      j["output"] = o.Output;
-      j["frames_folder"] = out.Frames.string();
-      j["frames"] = times.size();
-      j["t0"] = times.front();
-      j["t1"] = times.back();
-      j["records"] = records;
-      if (!o.Trace.empty())
-      {
-        j["trace"] = o.Trace;
-      }
-      j["transitions"] = nlohmann::ordered_json::array();
-      for (const Transition& tr : transitions)
-      {
-        j["transitions"].push_back({ { "time", tr.time }, { "from", tr.from }, { "to", tr.to } });
-      }
-      j["final_instance"] = model.activeInstance();
-      j["seconds"] = seconds;
-      j["engine_seconds"] = engineSeconds;
-      j["mesh_seconds"] = meshSeconds;
-      j["write_seconds"] = writeSeconds;
-      j["feature_size"] = mesher.featureSize();
-      j["max_step"] = maxStep;
-      j["coherence"] = { { "enabled", !o.NoCoherence }, { "computed", stats.computed },
-        { "moved", stats.moved }, { "reused", stats.reused } };
-      std::cout << j.dump(2) << "\n";
-      return 0;
-    }
-    std::cout << "wrote " << o.Output << " (" << times.size() << " frames, t = " << times.front()
-              << " .. " << times.back() << ", in " << out.Frames.filename().string() << "/)";
+    rethrowModelError();
+    throw std::runtime_error(failure.empty() ? "cannot write '" + o.Output + "'" : failure);
+  }
+  if (trace.enabled())
+  {
+    fs::rename(trace.Temporary, trace.Trace);
+    trace.Committed = true;
+  }
+  const double seconds = Seconds(started);
+  const fs::path frames = fs::absolute(o.Output).parent_path() / fs::path(o.Output).stem();
+  const std::size_t records = run.records;
+  const std::vector<Transition>& transitions = run.transitions;
+  const bool coherent = !o.NoCoherence;
+  const std::size_t computed = static_cast<std::size_t>(source->GetTotalCellsComputed());
+  const std::size_t moved = static_cast<std::size_t>(source->GetTotalCellsMoved());
+  const std::size_t reused = static_cast<std::size_t>(source->GetTotalCellsReused());
+  if (o.Json)
+  {
+    nlohmann::ordered_json j;
+    j["output"] = o.Output;
+    j["frames_folder"] = frames.string();
+    j["frames"] = times.size();
+    j["t0"] = times.front();
+    j["t1"] = times.back();
+    j["records"] = records;
     if (!o.Trace.empty())
     {
-      std::cout << " and " << o.Trace << " (" << records << " records)";
+      j["trace"] = o.Trace;
     }
-    std::cout << std::fixed << std::setprecision(3) << " in " << seconds << " s (engine "
-              << engineSeconds << " s, meshing " << meshSeconds << " s, writing " << writeSeconds
-              << " s)\n";
-    std::cout << std::defaultfloat << std::setprecision(10) << transitions.size() << " transition"
-              << (transitions.size() == 1 ? "" : "s");
-    // The first few: a model that switches instances often would bury the rest of the summary
-    // (the trace and --json have them all).
-    const std::size_t shown = std::min<std::size_t>(transitions.size(), 8);
-    for (std::size_t i = 0; i < shown; ++i)
+    j["transitions"] = nlohmann::ordered_json::array();
+    for (const Transition& tr : transitions)
     {
-      std::cout << (i ? ", " : ": ") << transitions[i].from << " -> " << transitions[i].to
-                << " at t = " << transitions[i].time;
+      j["transitions"].push_back({ { "time", tr.time }, { "from", tr.from }, { "to", tr.to } });
     }
-    if (shown < transitions.size())
-    {
-      std::cout << ", ... (" << transitions.size() - shown << " more)";
-    }
-    std::cout << "\n"
-              << "cells meshed " << stats.computed << ", moved " << stats.moved << ", reused "
-              << stats.reused << " (time coherence " << (o.NoCoherence ? "off" : "on")
-              << ", feature size " << std::setprecision(6) << mesher.featureSize() << ")\n";
+    j["final_instance"] = source->GetInstanceName();
+    j["seconds"] = seconds;
+    j["engine_seconds"] = engineSeconds;
+    j["mesh_seconds"] = meshSeconds;
+    j["write_seconds"] = writeSeconds;
+    j["feature_size"] = source->GetFeatureSizeInUse();
+    j["max_step"] = maxStep;
+    j["coherence"] = { { "enabled", coherent }, { "computed", computed }, { "moved", moved },
+      { "reused", reused } };
+    std::cout << j.dump(2) << "\n";
     return 0;
   }
-  catch (const Cancelled&)
+  std::cout << "wrote " << o.Output << " (" << times.size() << " frames, t = " << times.front()
+            << " .. " << times.back() << ", in " << frames.filename().string() << "/)";
+  if (!o.Trace.empty())
   {
-    bar.End();
-    std::cerr << "ictk: interrupted; nothing written\n";
-    return ExitInterrupted;
+    std::cout << " and " << o.Trace << " (" << records << " records)";
   }
-  catch (...)
+  std::cout << std::fixed << std::setprecision(3) << " in " << seconds << " s (engine "
+            << engineSeconds << " s, meshing " << meshSeconds << " s, writing " << writeSeconds
+            << " s)\n";
+  std::cout << std::defaultfloat << std::setprecision(10) << transitions.size() << " transition"
+            << (transitions.size() == 1 ? "" : "s");
+  // The first few: a model that switches instances often would bury the rest of the summary
+  // (the trace and --json have them all).
+  const std::size_t shown = std::min<std::size_t>(transitions.size(), 8);
+  for (std::size_t i = 0; i < shown; ++i)
   {
-    bar.End();
-    throw;
+    std::cout << (i ? ", " : ": ") << transitions[i].from << " -> " << transitions[i].to
+              << " at t = " << transitions[i].time;
   }
+  if (shown < transitions.size())
+  {
+    std::cout << ", ... (" << transitions.size() - shown << " more)";
+  }
+  std::cout << "\n"
+            << "cells meshed " << computed << ", moved " << moved << ", reused " << reused
+            << " (time coherence " << (o.NoCoherence ? "off" : "on") << ", feature size "
+            << std::setprecision(6) << source->GetFeatureSizeInUse() << ")\n";
+  return 0;
 }
 
 namespace

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkComplexSource.h"
+#include "ictkComplexToVTK.h"
 #include "ictkRequest.h"
 
 #include "Complex/Discretization.h"
@@ -10,9 +11,7 @@
 #include "vtkCellArray.h"
 #include "vtkCellType.h"
 #include "vtkDataAssembly.h"
-#include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
-#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseKey.h"
@@ -20,22 +19,18 @@
 #include "vtkIntArray.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMetaImageReader.h"
-#include "vtkMultiBlockDataSet.h"
 #include "vtkNIFTIImageReader.h"
 #include "vtkNew.h"
 #include "vtkNrrdReader.h"
 #include "vtkOBJReader.h"
 #include "vtkObjectFactory.h"
 #include "vtkPLYReader.h"
-#include "vtkPartitionedDataSet.h"
 #include "vtkPartitionedDataSetCollection.h"
 #include "vtkPointData.h"
-#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSTLReader.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
-#include "vtkStringArray.h"
 #include "vtkTriangleFilter.h"
 #include "vtkUnstructuredGrid.h"
 #include "vtkXMLImageDataReader.h"
@@ -47,7 +42,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <map>
 
 vtkStandardNewMacro(ictkComplexSource);
 vtkInformationKeyMacro(ictkComplexSource, COMPLEX, ObjectBase);
@@ -117,62 +111,6 @@ void ictkComplexSource::AttachComplex(
 namespace
 {
 using namespace ictk;
-
-vtkSmartPointer<vtkPolyData> toPolyData(const complex::CellMesh& m)
-{
-  auto pd = vtkSmartPointer<vtkPolyData>::New();
-  auto points = vtkSmartPointer<vtkPoints>::New();
-  points->SetDataTypeToDouble();
-  const auto& vertices = m.vertices();
-  points->SetNumberOfPoints(static_cast<vtkIdType>(vertices.size()));
-  for (std::size_t i = 0; i < vertices.size(); ++i)
-  {
-    points->SetPoint(static_cast<vtkIdType>(i), vertices[i].data());
-  }
-  pd->SetPoints(points);
-  auto cells = vtkSmartPointer<vtkCellArray>::New();
-  switch (m.dimension)
-  {
-    case 0:
-      for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i)
-      {
-        cells->InsertNextCell(1, &i);
-      }
-      pd->SetVerts(cells);
-      break;
-    case 1:
-      for (const auto& line : m.curves.lines)
-      {
-        cells->InsertNextCell(static_cast<vtkIdType>(line.size()));
-        for (auto i : line)
-        {
-          cells->InsertCellPoint(i);
-        }
-      }
-      pd->SetLines(cells);
-      break;
-    default:
-      for (const auto& t : m.surface.triangles)
-      {
-        const vtkIdType ids[3] = { t[0], t[1], t[2] };
-        cells->InsertNextCell(3, ids);
-      }
-      pd->SetPolys(cells);
-  }
-  const std::vector<discretize::PointArray>& arrays = m.dimension == 0 ? m.points.pointData
-    : m.dimension == 1                                                 ? m.curves.pointData
-                                                                       : m.surface.pointData;
-  for (const auto& a : arrays)
-  {
-    auto array = vtkSmartPointer<vtkDoubleArray>::New();
-    array->SetName(a.name.c_str());
-    array->SetNumberOfComponents(a.components);
-    array->SetNumberOfTuples(static_cast<vtkIdType>(vertices.size()));
-    std::copy(a.values.begin(), a.values.end(), array->GetPointer(0));
-    pd->GetPointData()->AddArray(array);
-  }
-  return pd;
-}
 
 bool endsWith(std::string s, const std::string& suffix)
 {
@@ -346,34 +284,6 @@ std::shared_ptr<voxel::VoxelGrid> readVolume(const std::string& path, const std:
   return grid;
 }
 
-/// A cell's solid field sampled on an image over its bounds.
-vtkSmartPointer<vtkImageData> sampleVolume(const complex::ImplicitGeometry& g, int resolution)
-{
-  const frep::FieldPtr field = g.inside.size() == 1 ? g.inside[0] : frep::minField(g.inside);
-  const voxel::VoxelGrid grid =
-    voxel::sampleToGrid(*field, g.bounds, { resolution, resolution, resolution });
-  auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetDimensions(static_cast<int>(grid.dimensions[0]), static_cast<int>(grid.dimensions[1]),
-    static_cast<int>(grid.dimensions[2]));
-  image->SetOrigin(grid.origin.data());
-  image->SetSpacing(grid.spacing.data());
-  auto f = vtkSmartPointer<vtkFloatArray>::New();
-  f->SetName("f");
-  f->SetNumberOfTuples(static_cast<vtkIdType>(grid.values.size()));
-  std::copy(grid.values.begin(), grid.values.end(), f->GetPointer(0));
-  image->GetPointData()->SetScalars(f);
-  return image;
-}
-
-template <typename T, typename V>
-void addField(vtkFieldData* fd, const char* name, V value)
-{
-  auto a = vtkSmartPointer<T>::New();
-  a->SetName(name);
-  a->InsertNextValue(value);
-  fd->AddArray(a);
-}
-
 } // namespace
 
 struct ictkComplexSource::Internals
@@ -407,150 +317,6 @@ complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path)
   readers.mesh = readMesh;
   readers.volume = readVolume;
   return lang::readComplexFile(path, {}, readers);
-}
-
-namespace
-{
-/// The assembly of a complex whose cells are the datasets of `layout`, in order.
-vtkSmartPointer<vtkDataAssembly> MakeAssembly(
-  const complex::Complex& k, const std::vector<complex::CellId>& layout)
-{
-  auto assembly = vtkSmartPointer<vtkDataAssembly>::New();
-  assembly->Initialize();
-  assembly->SetRootNodeName(
-    vtkDataAssembly::MakeValidNodeName(k.name.empty() ? "complex" : k.name.c_str()).c_str());
-  int dimensionNodes[4];
-  for (int p = 0; p <= 3; ++p)
-  {
-    dimensionNodes[p] = assembly->AddNode(("dimension_" + std::to_string(p)).c_str());
-  }
-  std::map<complex::CellId, unsigned int> index;
-  for (unsigned int i = 0; i < layout.size(); ++i)
-  {
-    const complex::Cell& c = k.cell(layout[i]);
-    const int node = assembly->AddNode(
-      vtkDataAssembly::MakeValidNodeName(c.name.c_str()).c_str(), dimensionNodes[c.dimension]);
-    assembly->SetAttribute(node, "cell", c.name.c_str());
-    assembly->AddDataSetIndex(node, i);
-    index[c.id] = i;
-  }
-  // The relations: for each cell, a node listing the datasets of the related cells.
-  const int relations = assembly->AddNode("relations");
-  struct Derived
-  {
-    const char* name;
-    std::vector<complex::CellId> (complex::Complex::*related)(complex::CellId) const;
-  };
-  const Derived kinds[] = {
-    { "boundary", &complex::Complex::boundaryOf },
-    { "containment", &complex::Complex::contentsOf },
-    { "coboundary", &complex::Complex::coboundaryOf },
-    { "contained_in", &complex::Complex::containersOf },
-  };
-  for (const Derived& d : kinds)
-  {
-    const int kindNode = assembly->AddNode(d.name, relations);
-    for (const auto& [id, dataset] : index)
-    {
-      (void)dataset;
-      std::vector<complex::CellId> related = (k.*d.related)(id);
-      related.erase(std::remove_if(related.begin(), related.end(),
-                      [&](complex::CellId r) { return !index.count(r); }),
-        related.end());
-      if (related.empty())
-      {
-        continue;
-      }
-      const std::string& name = k.cell(id).name;
-      const int node =
-        assembly->AddNode(vtkDataAssembly::MakeValidNodeName(name.c_str()).c_str(), kindNode);
-      assembly->SetAttribute(node, "cell", name.c_str());
-      for (complex::CellId r : related)
-      {
-        assembly->AddDataSetIndex(node, index.at(r));
-      }
-    }
-  }
-  return assembly;
-}
-} // namespace
-
-void ictkComplexSource::Convert(const complex::Complex& k, const complex::ComplexMesh& mesh,
-  vtkPartitionedDataSetCollection* output, int volumeResolution,
-  const std::vector<unsigned int>* layout)
-{
-  output->Initialize();
-  std::vector<complex::CellId> cells;
-  if (layout)
-  {
-    cells.assign(layout->begin(), layout->end());
-  }
-  else
-  {
-    for (const complex::CellMesh& m : mesh.cells)
-    {
-      cells.push_back(m.cell);
-    }
-  }
-  std::map<complex::CellId, const complex::CellMesh*> meshes;
-  for (const complex::CellMesh& m : mesh.cells)
-  {
-    meshes[m.cell] = &m;
-  }
-  for (unsigned int next = 0; next < cells.size(); ++next)
-  {
-    const complex::Cell& c = k.cell(cells[next]);
-    auto part = vtkSmartPointer<vtkPartitionedDataSet>::New();
-    vtkFieldData* fd = part->GetFieldData();
-    addField<vtkIntArray>(fd, "CellId", static_cast<int>(c.id));
-    addField<vtkStringArray>(fd, "CellName", c.name);
-    addField<vtkStringArray>(fd, "CellKind", std::string(complex::kindCode(c.kind)));
-    addField<vtkIntArray>(fd, "CellDimension", c.dimension);
-    addField<vtkStringArray>(fd, "CellDescription", c.description);
-    const auto found = meshes.find(c.id);
-    if (found != meshes.end())
-    {
-      vtkSmartPointer<vtkPolyData> leaf = toPolyData(*found->second);
-      part->SetPartition(0, leaf);
-      const auto* implicit = std::get_if<complex::ImplicitGeometry>(&c.geometry);
-      if (volumeResolution > 1 && c.dimension == 3 && implicit)
-      {
-        part->SetPartition(1, sampleVolume(*implicit, volumeResolution));
-      }
-      // The XML writers keep only the leaves' field data: copy it there too.
-      leaf->GetFieldData()->ShallowCopy(fd);
-    }
-    output->SetPartitionedDataSet(next, part);
-    output->GetMetaData(next)->Set(vtkCompositeDataSet::NAME(), c.name.c_str());
-  }
-  output->SetDataAssembly(MakeAssembly(k, cells));
-}
-
-void ictkComplexSource::ToMultiBlock(
-  vtkPartitionedDataSetCollection* input, vtkMultiBlockDataSet* output)
-{
-  output->Initialize();
-  vtkNew<vtkMultiBlockDataSet> byDimension[4];
-  for (unsigned int i = 0; i < input->GetNumberOfPartitionedDataSets(); ++i)
-  {
-    vtkPartitionedDataSet* part = input->GetPartitionedDataSet(i);
-    auto* dimension = vtkIntArray::SafeDownCast(part->GetFieldData()->GetArray("CellDimension"));
-    const int p = dimension ? dimension->GetValue(0) : 0;
-    vtkMultiBlockDataSet* block = byDimension[std::clamp(p, 0, 3)];
-    const unsigned int b = block->GetNumberOfBlocks();
-    block->SetBlock(b, part->GetPartition(0));
-    if (input->HasMetaData(i))
-    {
-      block->GetMetaData(b)->Set(
-        vtkCompositeDataSet::NAME(), input->GetMetaData(i)->Get(vtkCompositeDataSet::NAME()));
-    }
-  }
-  for (int p = 0; p <= 3; ++p)
-  {
-    output->SetBlock(p, byDimension[p]);
-    output->GetMetaData(static_cast<unsigned int>(p))
-      ->Set(vtkCompositeDataSet::NAME(), (std::to_string(p) + "D cells").c_str());
-  }
 }
 
 std::shared_ptr<const complex::Complex> ictkComplexSource::LoadComplex()
@@ -634,7 +400,7 @@ int ictkComplexSource::RequestInformation(
   try
   {
     const auto k = LoadComplex();
-    this->Internal->Assembly = MakeAssembly(*k, k->cellIds());
+    this->Internal->Assembly = ictk::vtk::complexAssembly(*k, k->cellIds());
     this->Internal->AssemblyOf = k;
     ++this->AssemblyTag;
   }
@@ -663,8 +429,9 @@ int ictkComplexSource::RequestData(
       if (!this->Selectors.empty())
       {
         // RequestInformation built the assembly of this complex (all cells, in order).
-        const vtkSmartPointer<vtkDataAssembly> assembly =
-          this->Internal->AssemblyOf == k ? this->Internal->Assembly : MakeAssembly(*k, all);
+        const vtkSmartPointer<vtkDataAssembly> assembly = this->Internal->AssemblyOf == k
+          ? this->Internal->Assembly
+          : ictk::vtk::complexAssembly(*k, all);
         const std::vector<int> nodes = assembly->SelectNodes(this->Selectors);
         std::vector<unsigned int> indices = assembly->GetDataSetIndices(nodes, true);
         std::sort(indices.begin(), indices.end());
@@ -702,8 +469,7 @@ int ictkComplexSource::RequestData(
         options.cells = share;
         mesh = complex::discretizeComplex(*k, options);
       }
-      const std::vector<unsigned int> layout(all.begin(), all.end());
-      Convert(*k, mesh, output, this->VolumeResolution, &layout);
+      ictk::vtk::complexToVTK(*k, mesh, output, this->VolumeResolution, &all);
       AttachComplex(output, k);
       return 1;
     });

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class ictkComplexSource
- * @brief Discretises an implicit complex and outputs it as a vtkPartitionedDataSetCollection.
+ * @brief The reader of implicit complexes: discretises a complex and outputs it as a
+ * vtkPartitionedDataSetCollection.
  *
  * The complex comes from a .json complex file (SetFileName; cells may name VTK mesh and image
  * files, see ReadComplexFile) or, in C++, from SetComplex(). Every
@@ -12,13 +13,18 @@
  * With VolumeResolution > 0, the partitioned dataset of every implicit 3D cell also holds the
  * cell's field sampled on a vtkImageData (array "f").
  *
- * Each partitioned dataset's field data holds CellId, CellName, CellKind, CellDimension and
- * CellDescription. The collection's vtkDataAssembly has the nodes
+ * The output is the VTK form of a complex that ictkComplexToVTK.h describes and makes (shared with
+ * ictkDynamicComplexSource): each partitioned dataset's field data holds CellId, CellName,
+ * CellKind, CellDimension and CellDescription; the collection's vtkDataAssembly has the nodes
  *   /dimension_0 .. /dimension_3: the cells by dimension;
  *   /relations/boundary/<cell>: the cells on the boundary of <cell> (Rb);
  *   /relations/containment/<cell>: the cells <cell> contains (Rc);
  *   /relations/coboundary/<cell>, /relations/contained_in/<cell>: the derived inverses;
  * each node carrying the cell name in its "cell" attribute (node names are made XML-valid).
+ *
+ * The complex itself rides along with the output (COMPLEX(), GetComplex()), so that filters
+ * downstream (ictkTetrahedralize, ictkComplexValidator) can use its fields, not only its
+ * discretisation; ictkDynamicComplexSource attaches its frames' complexes the same way.
  *
  * Selectors (AddSelector; vtkDataAssembly paths, which start at the root node named after the
  * complex: "/flower/dimension_2", or anywhere with "//dimension_2", "//petal_1",
@@ -47,7 +53,6 @@
 class vtkDataAssembly;
 class vtkDataObject;
 class vtkInformationObjectBaseKey;
-class vtkMultiBlockDataSet;
 class vtkPartitionedDataSetCollection;
 
 #ifndef __VTK_WRAP__
@@ -56,7 +61,6 @@ namespace ictk
 namespace complex
 {
 class Complex;
-struct ComplexMesh;
 } // namespace complex
 } // namespace ictk
 #endif
@@ -102,14 +106,14 @@ public:
   /// that other JSON files are left to other readers.
   static int CanReadFile(const char* name);
 
-  /// Set on the output's information, and on the information of its field array "ICTKComplex"
-  /// (so that shallow copies, such as ParaView's vtkPVPostFilter, keep it): the complex itself, so
-  /// that downstream filters (ictkTetrahedralize) can use its fields, not only its discretisation.
+  /// The information key that carries a complex with its VTK form: set on the output's
+  /// information, and on the information of its field array "ICTKComplex" (whose value is the
+  /// number of cells), so that shallow copies, such as ParaView's vtkPVPostFilter, keep it. Its
+  /// value is an opaque holder of the shared complex: read it with GetComplex(), set it with
+  /// AttachComplex(). It lives on this class because the sources of complexes (this one and
+  /// ictkDynamicComplexSource) and the filters that use them (ictkTetrahedralize,
+  /// ictkComplexValidator) all depend on this module.
   static vtkInformationObjectBaseKey* COMPLEX();
-
-  /// The cells as a vtkMultiBlockDataSet (blocks per dimension, then one per cell, named), for
-  /// consumers that do not read partitioned dataset collections (.vtm files).
-  static void ToMultiBlock(vtkPartitionedDataSetCollection* input, vtkMultiBlockDataSet* output);
 
 #ifndef __VTK_WRAP__
   /// Reads a .json complex with VTK's readers for the cells' files: explicit cells from .vtp,
@@ -124,12 +128,6 @@ public:
     vtkDataObject* data, std::shared_ptr<const ictk::complex::Complex> complex);
   /// A complex built in C++; used instead of FileName when set.
   void SetComplex(std::shared_ptr<const ictk::complex::Complex> complex);
-  /// The VTK form of a discretised complex. `layout`: the cells that get a partitioned dataset,
-  /// in order (null: the mesh's cells); a cell of the layout that the mesh lacks gets an empty
-  /// one, so that every piece of a distributed complex has the same structure.
-  static void Convert(const ictk::complex::Complex& complex, const ictk::complex::ComplexMesh& mesh,
-    vtkPartitionedDataSetCollection* output, int volumeResolution = 0,
-    const std::vector<unsigned int>* layout = nullptr);
 #endif
 
 protected:

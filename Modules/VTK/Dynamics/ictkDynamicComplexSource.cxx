@@ -2,10 +2,9 @@
 #include "ictkDynamicComplexSource.h"
 #include "ictkRequest.h"
 
-#include "Engine/CoherentDiscretizer.h"
-#include "Engine/DynamicModel.h"
-#include "FRep/Sampling.h"
+#include "Engine/FrameSequence.h"
 #include "ictkComplexSource.h"
+#include "ictkComplexToVTK.h"
 
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -20,7 +19,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <iomanip>
 #include <sstream>
 
@@ -38,82 +36,22 @@ std::string Describe(const engine::ModelError& e)
   return os.str();
 }
 
-/// t0, t0 + h, ... up to t1, with t1 itself as the last step when the spacing does not reach it
-/// exactly (a step within h / 1000 of t1 is t1: the rounding of t0 + k h) - as `ictk run --time`.
-std::vector<double> UniformSteps(double t0, double t1, double h)
-{
-  std::vector<double> steps;
-  if (!(t1 > t0) || !(h > 0))
-  {
-    steps.push_back(t0);
-    return steps;
-  }
-  const double count = std::floor((t1 - t0) / h + 1e-3);
-  // A time step list is for people and pipelines to walk through; refuse absurd ones rather than
-  // allocate them.
-  const double limit = 1e6;
-  const auto n = static_cast<long long>(std::min(count, limit));
-  for (long long k = 0; k <= n; ++k)
-  {
-    steps.push_back(t0 + static_cast<double>(k) * h);
-  }
-  if (std::abs(t1 - steps.back()) < 1e-3 * h)
-  {
-    steps.back() = t1;
-  }
-  else if (count < limit)
-  {
-    steps.push_back(t1);
-  }
-  return steps;
-}
-
 } // namespace
 
 struct ictkDynamicComplexSource::Internals
 {
-  std::unique_ptr<engine::DynamicModel> Model;
-  std::unique_ptr<engine::CoherentDiscretizer> Mesher;
-  /// The settings the model and the kept meshes were made under: when they change, both start
-  /// again.
+  std::unique_ptr<engine::FrameSequence> Frames;
+  /// The settings the frames were made under: when they change, the model starts again.
   std::string Configuration;
-  std::vector<double> Steps; ///< advertised
-  double EngineStep = 0;
-  /// A run was cancelled between two advertised times: the next request starts again, so that
-  /// what is computed does not depend on where the cancel fell.
-  bool Interrupted = false;
-  /// The engine stands at a time between the advertised ones: going on from there would give
-  /// later frames one more stop than a run from the start, so the next later request restarts.
-  bool OffGrid = false;
-  /// The span of the progress range the engine's current advanceTo() fills.
-  double ProgressLo = 0;
-  double ProgressHi = 0.5;
-  /// Reports the engine's progress into that span and passes AbortExecute back as a cancel.
-  std::function<bool(double)> EngineProgress;
-
-  /// The model (again) at its start.
-  void Load(const std::string& file)
-  {
-    engine::RunOptions options;
-    options.progress = this->EngineProgress;
-    this->Model =
-      std::make_unique<engine::DynamicModel>(engine::DynamicModel::load(file, std::move(options)));
-    this->Model->start();
-    this->Interrupted = false;
-    this->OffGrid = false;
-  }
+  /// The records of the last frame output.
+  std::vector<engine::FrameRecord> Records;
+  std::exception_ptr LastError;
 };
 
 ictkDynamicComplexSource::ictkDynamicComplexSource()
   : Internal(new Internals)
 {
   this->SetNumberOfInputPorts(0);
-  this->Internal->EngineProgress = [this](double fraction)
-  {
-    const Internals& s = *this->Internal;
-    this->UpdateProgress(s.ProgressLo + (s.ProgressHi - s.ProgressLo) * fraction);
-    return !this->GetAbortExecute();
-  };
 }
 
 ictkDynamicComplexSource::~ictkDynamicComplexSource() = default;
@@ -157,8 +95,7 @@ int ictkDynamicComplexSource::RequestInformation(
   {
     if (this->FileName.empty())
     {
-      vtkErrorMacro("no model: set FileName (a .icm file)");
-      return 0;
+      throw std::invalid_argument("no model: set FileName (a .icm file)");
     }
     std::ostringstream configuration;
     configuration << std::setprecision(17) << this->FileName << "|" << this->FeatureSize << "|"
@@ -168,67 +105,51 @@ int ictkDynamicComplexSource::RequestInformation(
     {
       configuration << "|" << t;
     }
-    if (!in.Model || configuration.str() != in.Configuration)
+    if (!in.Frames || configuration.str() != in.Configuration)
     {
-      in.Model.reset();
-      in.Mesher.reset();
+      in.Frames.reset();
       in.Configuration.clear();
-      in.Load(this->FileName);
-
-      const auto [t0, t1] = in.Model->timeRange();
-      if (!this->TimeSteps.empty())
-      {
-        in.Steps = this->TimeSteps;
-      }
-      else
-      {
-        const double h = this->TimeStepSize > 0 ? this->TimeStepSize : (t1 - t0) / 100;
-        in.Steps = UniformSteps(t0, t1, h);
-      }
-      double spacing = 0;
-      for (std::size_t i = 1; i < in.Steps.size(); ++i)
-      {
-        const double d = in.Steps[i] - in.Steps[i - 1];
-        spacing = spacing > 0 ? std::min(spacing, d) : d;
-      }
-      in.EngineStep = this->MaximumStep > 0 ? this->MaximumStep
-        : spacing > 0                       ? spacing
-        : t1 > t0                           ? (t1 - t0) / 100
-                                            : 1.0;
-
-      engine::CoherenceOptions mesherOptions;
-      mesherOptions.featureSize = this->FeatureSize;
-      mesherOptions.coherent = this->Coherent != 0;
-      mesherOptions.threads = this->NumberOfThreads;
-      mesherOptions.progress = ictk::vtk::progressOf(this, 0.5, 1.0);
-      in.Mesher = std::make_unique<engine::CoherentDiscretizer>(std::move(mesherOptions));
-      if (!(this->FeatureSize > 0))
-      {
-        // Fixed from the model's start, whatever time is asked for first.
-        in.Mesher->setFeatureSize(ictk::complex::defaultFeatureSize(in.Model->complex()));
-      }
+      engine::FrameSequenceOptions options;
+      options.times = this->TimeSteps;
+      options.timeStep = this->TimeStepSize;
+      options.maxStep = this->MaximumStep;
+      options.discretization.featureSize = this->FeatureSize;
+      options.discretization.coherent = this->Coherent != 0;
+      options.discretization.threads = this->NumberOfThreads;
+      options.progress = ictk::vtk::progressOf(this);
+      in.Frames = std::make_unique<engine::FrameSequence>(this->FileName, std::move(options));
       in.Configuration = configuration.str();
     }
+    const std::vector<double>& steps = in.Frames->times();
     vtkInformation* outInfo = outputVector->GetInformationObject(0);
-    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), in.Steps.data(),
-      static_cast<int>(in.Steps.size()));
-    const double range[2] = { in.Steps.front(), in.Steps.back() };
+    outInfo->Set(
+      vtkStreamingDemandDrivenPipeline::TIME_STEPS(), steps.data(), static_cast<int>(steps.size()));
+    const double range[2] = { steps.front(), steps.back() };
     outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
     outInfo->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
+    in.LastError = nullptr;
     return 1;
-  }
-  catch (const engine::ModelError& e)
-  {
-    vtkErrorMacro("" << Describe(e));
   }
   catch (const std::exception& e)
   {
-    vtkErrorMacro("" << e.what());
+    in.LastError = std::current_exception();
+    this->ReportError(e);
   }
-  in.Model.reset();
-  in.Mesher.reset();
+  in.Frames.reset();
   in.Configuration.clear();
   return 0;
+}
+
+void ictkDynamicComplexSource::ReportError(const std::exception& e)
+{
+  if (const auto* m = dynamic_cast<const engine::ModelError*>(&e))
+  {
+    vtkErrorMacro("" << Describe(*m));
+  }
+  else
+  {
+    vtkErrorMacro("" << e.what());
+  }
 }
 
 int ictkDynamicComplexSource::RequestData(
@@ -237,85 +158,40 @@ int ictkDynamicComplexSource::RequestData(
   Internals& in = *this->Internal;
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkPartitionedDataSetCollection* output = vtkPartitionedDataSetCollection::GetData(outputVector);
-  if (!in.Model || in.Steps.empty())
+  in.Records.clear();
+  if (!in.Frames)
   {
     vtkErrorMacro("no model loaded");
     return 0;
   }
-  double t = in.Steps.front();
+  const std::vector<double>& steps = in.Frames->times();
+  double t = steps.front();
   if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
   {
     t = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
   }
-  t = std::clamp(t, in.Steps.front(), in.Steps.back());
   try
   {
-    if (in.Interrupted || t < in.Model->time() || (in.OffGrid && t != in.Model->time()))
-    {
-      // The engine only runs forwards: start again from the model's start (the kept meshes go
-      // too, since shape versions count within one run).
-      in.Load(this->FileName);
-      in.Mesher->reset();
-    }
-    // Every advertised time on the way is a stop, so that a frame is computed by the same steps
-    // whichever frames were asked for before it.
-    std::vector<double> stops;
-    for (double s : in.Steps)
-    {
-      if (s > in.Model->time() && s < t)
-      {
-        stops.push_back(s);
-      }
-    }
-    if (t > in.Model->time())
-    {
-      stops.push_back(t);
-    }
-    for (std::size_t i = 0; i < stops.size(); ++i)
-    {
-      in.ProgressLo = 0.5 * double(i) / double(stops.size());
-      in.ProgressHi = 0.5 * double(i + 1) / double(stops.size());
-      in.Model->advanceTo(stops[i], in.EngineStep);
-    }
-    this->UpdateProgress(0.5);
-    in.OffGrid = !std::binary_search(in.Steps.begin(), in.Steps.end(), t);
-
-    const std::vector<engine::CellState> cells = in.Model->cells();
-    auto k = std::make_shared<const ictk::complex::Complex>(in.Model->complex());
     // Under MPI every rank runs the engine (cheap, deterministic) and discretises its share of
-    // the cells (cell i to piece i mod N); every piece has the whole collection's structure.
-    const int pieces =
+    // the cells; every piece has the whole collection's structure.
+    engine::CellShare share;
+    share.pieces =
       std::max(1, outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()));
-    const int piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
-    const std::vector<ictk::complex::CellId> all = k->cellIds();
-    std::vector<ictk::complex::CellId> share;
-    for (std::size_t i = 0; i < all.size(); ++i)
-    {
-      if (static_cast<int>(i % static_cast<std::size_t>(pieces)) == piece)
-      {
-        share.push_back(all[i]);
-      }
-    }
-    ictk::complex::ComplexMesh mesh;
-    if (pieces == 1)
-    {
-      mesh = in.Mesher->discretize(cells, *k);
-    }
-    else if (!share.empty())
-    {
-      mesh = in.Mesher->discretize(cells, *k, share);
-    }
-    const std::vector<unsigned int> layout(all.begin(), all.end());
-    ictkComplexSource::Convert(*k, mesh, output, 0, &layout);
-    ictkComplexSource::AttachComplex(output, k);
+    share.piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+    engine::Frame frame = in.Frames->at(t, share);
+    in.LastError = nullptr;
+    const std::vector<ictk::complex::CellId> all = frame.complex->cellIds();
+    ictk::vtk::complexToVTK(*frame.complex, frame.mesh, output, 0, &all);
+    ictkComplexSource::AttachComplex(output, frame.complex);
 
-    this->InstanceName = in.Model->activeInstance();
-    this->ModelTime = in.Model->time();
-    AddFrameFields(output, this->InstanceName.c_str(), t);
-    output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), t);
+    this->InstanceName = frame.instance;
+    this->ModelTime = in.Frames->model().time();
+    in.Records = std::move(frame.records);
+    AddFrameFields(output, this->InstanceName.c_str(), frame.time);
+    output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), frame.time);
 
-    const engine::CoherenceStats& last = in.Mesher->lastFrame();
-    const engine::CoherenceStats& total = in.Mesher->total();
+    const engine::CoherenceStats& last = in.Frames->discretizer().lastFrame();
+    const engine::CoherenceStats& total = in.Frames->discretizer().total();
     this->Stats[0] = static_cast<int>(last.computed);
     this->Stats[1] = static_cast<int>(last.moved);
     this->Stats[2] = static_cast<int>(last.reused);
@@ -327,24 +203,38 @@ int ictkDynamicComplexSource::RequestData(
   }
   catch (const ictk::Cancelled&)
   {
-    // Cancelled in the engine's run or in the meshing: start again from the model's start next
-    // time, so that no frame depends on where a cancellation fell.
-    in.Interrupted = true;
+    // The sequence starts the model again next time, so that no frame depends on where a
+    // cancellation fell.
     output->Initialize();
     return 1;
   }
-  catch (const engine::ModelError& e)
-  {
-    vtkErrorMacro("" << Describe(e));
-  }
   catch (const std::exception& e)
   {
-    vtkErrorMacro("" << e.what());
+    in.LastError = std::current_exception();
+    this->ReportError(e);
   }
-  // A failure may leave the engine between frames: start again next time.
-  in.Interrupted = true;
   output->Initialize();
   return 0;
+}
+
+double ictkDynamicComplexSource::GetStartTime() const
+{
+  return this->Internal->Frames ? this->Internal->Frames->startTime() : 0.0;
+}
+
+double ictkDynamicComplexSource::GetFeatureSizeInUse() const
+{
+  return this->Internal->Frames ? this->Internal->Frames->discretizer().featureSize() : 0.0;
+}
+
+const std::vector<ictk::engine::FrameRecord>& ictkDynamicComplexSource::GetFrameRecords() const
+{
+  return this->Internal->Records;
+}
+
+std::exception_ptr ictkDynamicComplexSource::GetLastError() const
+{
+  return this->Internal->LastError;
 }
 
 void ictkDynamicComplexSource::AddFrameFields(

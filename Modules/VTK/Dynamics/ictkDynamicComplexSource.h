@@ -4,16 +4,21 @@
  * @brief Runs a dynamic implicit complex (.icm model) and outputs, at the time the pipeline asks
  * for, the complex of the model's active instance as a vtkPartitionedDataSetCollection.
  *
- * RequestInformation advertises TIME_STEPS and TIME_RANGE: the times in SetTimeSteps() when
- * given, otherwise the model's time range (the union of its time spans) from its start at every
- * TimeStepSize, its end included. RequestData honours UPDATE_TIME_STEP (clamped to that range):
- * the engine is advanced to the requested time through every advertised time step before it, in
- * steps of at most MaximumStep (transitions between instances are located on the way), so the
- * output at a time does not depend on the order in which times were requested; a time earlier
- * than the engine's restarts the model from its start. The output carries DATA_TIME_STEP, the
- * complex itself (ictkComplexSource::COMPLEX()), and the field data "Instance" (the active
- * instance's name) and "Time". Its cells and vtkDataAssembly are those of ictkComplexSource, so
- * they change when the instance changes.
+ * The frames are those of ictk::engine::FrameSequence (Modules/Core/Engine/FrameSequence.h),
+ * ICTK's one frame loop. RequestInformation advertises TIME_STEPS and TIME_RANGE: the times in
+ * SetTimeSteps() when given, otherwise the model's time range (the union of its time spans) from
+ * its start at every TimeStepSize, its end included (ictk::engine::frameTimes). RequestData
+ * honours UPDATE_TIME_STEP (clamped to that range): the engine is advanced to the requested time
+ * through every advertised time step before it, in steps of at most MaximumStep (transitions
+ * between instances are located on the way), so the output at a time does not depend on the
+ * order in which times were requested; a time earlier than the engine's restarts the model from
+ * its start. The output carries DATA_TIME_STEP, the complex itself (ictkComplexSource::COMPLEX()),
+ * and the field data "Instance" (the active instance's name) and "Time". Its cells and
+ * vtkDataAssembly are the VTK form of a complex (ictkComplexToVTK.h), as ictkComplexSource's, so
+ * they change when the instance changes. In C++, GetFrameRecords() gives the engine's records on
+ * the way to the last frame (what `ictk run --trace` writes).
+ *
+ * Written as a time series (.pvd and one .vtpc per frame) by ictkTimeSeriesWriter.
  *
  * Frames are discretised with time coherence (ictk::engine::CoherentDiscretizer): a cell whose
  * shape did not change since it was last meshed is moved, not re-meshed. FeatureSize is the same
@@ -31,11 +36,22 @@
 #include "ictkFiltersDynamicsModule.h" // export macro
 #include "vtkPartitionedDataSetCollectionAlgorithm.h"
 
-#include <memory> // for std::unique_ptr
-#include <string> // for std::string
-#include <vector> // for std::vector
+#include <exception> // for std::exception_ptr
+#include <memory>    // for std::unique_ptr
+#include <string>    // for std::string
+#include <vector>    // for std::vector
 
 class vtkPartitionedDataSetCollection;
+
+#ifndef __VTK_WRAP__
+namespace ictk
+{
+namespace engine
+{
+struct FrameRecord;
+} // namespace engine
+} // namespace ictk
+#endif
 
 class ICTKFILTERSDYNAMICS_EXPORT ictkDynamicComplexSource
   : public vtkPartitionedDataSetCollectionAlgorithm
@@ -91,6 +107,23 @@ public:
   int GetTotalCellsMoved() const { return this->TotalStats[1]; }
   int GetTotalCellsReused() const { return this->TotalStats[2]; }
 
+  /// The model's time at its start and the feature size the frames are discretised at
+  /// (FeatureSize, or the one chosen at the model's start when that is 0); known after
+  /// UpdateInformation().
+  double GetStartTime() const;
+  double GetFeatureSizeInUse() const;
+
+#ifndef __VTK_WRAP__
+  /// The engine's records on the way to the last frame output, since the frame before it (from
+  /// the model's start, its start record first, when the model was started for it): one per
+  /// evaluated time, requested or a located transition. Empty after a failed or cancelled frame.
+  const std::vector<ictk::engine::FrameRecord>& GetFrameRecords() const;
+  /// The exception behind the last failed request (lang::ParseError, engine::ModelError, ...),
+  /// or null: for C++ front ends that report errors in their own form (the request itself reports
+  /// it with vtkErrorMacro, "file:line:col: error: ..." for a model's errors).
+  std::exception_ptr GetLastError() const;
+#endif
+
   /// Stamps a frame: the field data "Instance" (the active instance's name) and "Time" on the
   /// collection and on every leaf (the XML writers keep only the leaves' field data).
   static void AddFrameFields(
@@ -122,4 +155,6 @@ private:
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
+  /// vtkErrorMacro with a model's errors in the front ends' form.
+  void ReportError(const std::exception& e);
 };
