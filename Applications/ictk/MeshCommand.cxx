@@ -13,8 +13,6 @@
 #include "ictkComplexSource.h"
 #include "ictkComplexToVTK.h"
 
-#include <vtkCallbackCommand.h>
-#include <vtkCommand.h>
 #include <vtkImageData.h>
 #include <vtkMultiBlockDataSet.h>
 #include <vtkNew.h>
@@ -104,23 +102,17 @@ private:
     source->SetFeatureSize(this->Size);
     source->SetNumberOfThreads(o.Threads);
     source->SetVolumeResolution(this->VolumeResolution);
-    // The source reports failures as VTK errors; keep the message for our own error line.
-    std::string failure;
-    vtkNew<vtkCallbackCommand> onError;
-    onError->SetClientData(&failure);
-    onError->SetCallback(
-      [](vtkObject*, unsigned long, void* clientData, void* callData) {
-        *static_cast<std::string*>(clientData) = callData ? static_cast<const char*>(callData) : "";
-      });
-    source->AddObserver(vtkCommand::ErrorEvent, onError);
+    // The source reports failures as VTK errors; the first one becomes our own error line.
+    ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+    const std::size_t errorsBefore = messages->Errors.size();
     source->Update();
-    if (!failure.empty() || source->GetOutput()->GetNumberOfPartitionedDataSets() == 0)
+    if (messages->Errors.size() > errorsBefore ||
+      source->GetOutput()->GetNumberOfPartitionedDataSets() == 0)
     {
-      const auto at = failure.find("): ");
+      const std::string failure =
+        messages->Errors.size() > errorsBefore ? messages->Errors[errorsBefore] : std::string();
       throw UserError("cannot discretise '" + o.Model + "'" +
-        (failure.empty() ? std::string()
-                         : ": " + failure.substr(at == std::string::npos ? 0 : at + 3)) +
-        "; nothing written");
+        (failure.empty() ? std::string() : ": " + failure) + "; nothing written");
     }
     vtkPartitionedDataSetCollection* pdc = source->GetOutput();
     if (HasExtension(o.Output, ".vtpc"))

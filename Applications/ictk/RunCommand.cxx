@@ -7,6 +7,7 @@
 #include "Command.h"
 #include "Options.h"
 #include "Progress.h"
+#include "VtkMessages.h"
 
 #include "Engine/DynamicModel.h"
 #include "Engine/FrameSequence.h"
@@ -171,20 +172,6 @@ private:
   std::vector<unsigned long> tags_;
 };
 
-/// The text of a VTK error event: "ERROR: In file.cxx, line N\nclass (0x...): message" ->
-/// "message".
-std::string VtkErrorText(const char* event)
-{
-  std::string text = event ? event : "";
-  const auto at = text.find("): ");
-  if (at != std::string::npos)
-  {
-    text = text.substr(at + 3);
-  }
-  text.erase(text.find_last_not_of(" \t\r\n") + 1);
-  return text;
-}
-
 struct Transition
 {
   double time;
@@ -229,18 +216,12 @@ int RunModel(const RunModelOptions& o)
   writer->SetFileName(o.Output.c_str());
 
   // VTK's errors become this command's (the first one, kept rather than printed).
-  std::string failure;
-  auto onError = [&](unsigned long, void* callData)
+  ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+  const std::size_t errorsBefore = messages->Errors.size();
+  auto failure = [&]
   {
-    if (failure.empty())
-    {
-      failure = VtkErrorText(static_cast<const char*>(callData));
-    }
+    return messages->Errors.size() > errorsBefore ? messages->Errors[errorsBefore] : std::string();
   };
-  const Observer errors[] = { { source, { vtkCommand::ErrorEvent }, onError },
-    { source->GetExecutive(), { vtkCommand::ErrorEvent }, onError },
-    { writer, { vtkCommand::ErrorEvent }, onError },
-    { writer->GetExecutive(), { vtkCommand::ErrorEvent }, onError } };
   // A model error in the front ends' form, with the source line and a caret.
   auto rethrowModelError = [&]
   {
@@ -261,9 +242,9 @@ int RunModel(const RunModelOptions& o)
   const auto loadStart = Clock::now();
   source->UpdateInformation();
   rethrowModelError();
-  if (!failure.empty())
+  if (!failure().empty())
   {
-    throw std::runtime_error(failure);
+    throw std::runtime_error(failure());
   }
   if (times.front() < source->GetStartTime())
   {
@@ -388,7 +369,7 @@ int RunModel(const RunModelOptions& o)
       return ExitInterrupted;
     }
     rethrowModelError();
-    throw std::runtime_error(failure.empty() ? "cannot write '" + o.Output + "'" : failure);
+    throw std::runtime_error(failure().empty() ? "cannot write '" + o.Output + "'" : failure());
   }
   if (trace.enabled())
   {

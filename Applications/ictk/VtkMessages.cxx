@@ -3,6 +3,7 @@
 
 #include "Command.h"
 
+#include <vtkLogger.h>
 #include <vtkObjectFactory.h>
 #include <vtkSmartPointer.h>
 
@@ -58,6 +59,8 @@ ictkCaptureOutputWindow* CaptureVtkMessages()
   {
     window = vtkSmartPointer<ictkCaptureOutputWindow>::New();
     vtkOutputWindow::SetInstance(window);
+    // VTK >= 9.1 also logs every error through vtkLogger to stderr, besides the output window.
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
   }
   return window;
 }
