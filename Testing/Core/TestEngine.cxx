@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The engine that runs .icm models (Modules/Core/Engine), on the exemplars of thesis ch. 4.4 and 5
 // (Data/Models/icm). Every expected value is derived by hand in the comment next to it.
+#include "Engine/Builtins.h"
 #include "Engine/DynamicModel.h"
 #include "Lang/Icm.h"
 
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <string>
 
 namespace
@@ -470,4 +472,49 @@ TEST(EngineExemplars, OneRecordPerRequestedFrame)
     for (const FrameRecord& r : m.advanceTo(i * 0.1, 0.1))
       records += r.transition ? 0 : 1;
   EXPECT_EQ(records, 20u);
+}
+
+// One table of built-ins (Lang/IcmBuiltins.h): the engine implements every entry once, in the
+// layer the entry names, and nothing else.
+TEST(EngineBuiltins, EveryEntryHasOneImplementation)
+{
+  const std::vector<std::string> problems = ictk::engine::implementationProblems();
+  std::string all;
+  for (const std::string& p : problems)
+    all += p + "\n";
+  EXPECT_TRUE(problems.empty()) << all;
+  EXPECT_EQ(ictk::engine::interpreterBuiltins().size() + ictk::engine::libraryBuiltins().size(),
+    ictk::lang::icm::builtins().size());
+}
+
+// docs/icm.md's table of built-ins is the table's rendering (builtinsMarkdown): the rows after the
+// `<!-- builtins` marker, up to the first line that is not a row, header excluded.
+TEST(Docs, IcmBuiltins)
+{
+  std::ifstream in(std::string(ICTK_DATA_DIR) + "/../docs/icm.md");
+  ASSERT_TRUE(in) << "docs/icm.md";
+  std::string line, rows;
+  bool marker = false, table = false;
+  while (std::getline(in, line))
+  {
+    if (!marker)
+    {
+      marker = line.rfind("<!-- builtins", 0) == 0;
+      continue;
+    }
+    if (line.rfind("|---", 0) == 0)
+    {
+      table = true;
+      continue;
+    }
+    if (!table)
+      continue;
+    if (line.rfind("|", 0) != 0)
+      break;
+    rows += line + "\n";
+  }
+  ASSERT_TRUE(marker) << "docs/icm.md has no <!-- builtins marker";
+  EXPECT_EQ(rows, ictk::lang::icm::builtinsMarkdown())
+    << "docs/icm.md's built-ins differ from Lang/IcmBuiltins.cxx; the table's rows should be:\n"
+    << ictk::lang::icm::builtinsMarkdown();
 }

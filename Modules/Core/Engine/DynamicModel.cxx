@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Engine/DynamicModel.h"
 
-#include "Dynamics/Animation.h"
-#include "Dynamics/Stepper.h"
-#include "FRep/Tape.h"
+#include "Engine/Builtins.h"
+#include "Engine/ModelState.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 
@@ -20,119 +19,8 @@
 namespace ictk::engine
 {
 
-using lang::icm::CellDef;
-using lang::icm::Expr;
-using lang::icm::ExprPtr;
-using lang::icm::Instance;
-using lang::icm::ParamDecl;
-using lang::icm::Pos;
-using lang::icm::Procedure;
-using lang::icm::Property;
-using lang::icm::Relation;
-
 namespace
 {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-// The instance entity comes first in its plan: its update is the one that drives the cells.
-constexpr double kInstancePriority = 1e300;
-
-/// A parameter of a cell, an instance or the model.
-struct ParamSpec
-{
-  Pos pos;
-  std::string name;
-  Value initial;
-};
-
-/// `alias name` in STATE_PARAMETERS: a name for a path (a parameter of a cell or the instance).
-struct AliasSpec
-{
-  std::string name;
-  ExprPtr path;
-};
-
-struct CellSpec
-{
-  std::string name;
-  Pos pos;
-  complex::CellKind kind = complex::CellKind::FRep;
-  int dimension = 3;
-  frep::Box3 domain;
-  bool hasDomain = false;
-  bool hasLifespan = false;
-  dyn::TimeSpan life = dyn::TimeSpan::infinite();
-  bool hasClock = false;
-  dyn::TimeSpan clock = dyn::TimeSpan::infinite();
-  double priority = 0.0;
-  std::vector<ShapePart> parts; ///< from `shape =` (empty: a T-cell set by reactions)
-  /// A HyperFun/XML field, kept as a tape so setShapeParameter can rebind its parameters.
-  frep::TapePtr tape;
-  int parameterCount = 0;
-  std::size_t fieldPart = kNone;
-  /// blend(A, B, amount) / union(A, B): operands are cells, placed when the shape is needed.
-  struct Operands
-  {
-    ShapePart::Kind kind = ShapePart::Kind::Union;
-    std::string a, b;
-    double amount = 0.0;
-  };
-  std::optional<Operands> operands;
-  std::vector<ParamSpec> params;
-  std::map<std::string, const Procedure*> reactions; ///< "update", "react:EVENT", ...
-};
-
-struct RelationSpec
-{
-  Pos pos;
-  std::string name;
-  std::string master, masterMember; ///< cell (or instance/model parameter) and member path
-  std::string dependent, dependentMember;
-  double priority = 1.0;
-  bool hierarchical = false;
-};
-
-/// An attribute (thesis L864): a HyperFun function of the cell's local coordinates, or an
-/// external mapping known only by name (no function: it is not evaluated).
-struct AttributeSpec
-{
-  std::string name;
-  frep::TapePtr tape;
-  int dimension = 3;
-  std::string text;
-};
-
-struct InstanceSpec
-{
-  std::string name;
-  Pos pos;
-  bool isTemplate = false;
-  std::vector<std::string> cells;
-  std::vector<RelationSpec> boundary, containment, dependency;
-  std::vector<ParamSpec> params;       ///< instance parameters and typed state parameters
-  std::vector<std::string> stateNames; ///< typed state parameters and aliases, in order
-  std::vector<AliasSpec> aliases;
-  std::map<std::string, const Procedure*> reactions;
-  std::map<std::string, std::map<std::string, const Procedure*>> cellReactions;
-  const Procedure* predicate = nullptr;
-  std::set<std::string> reactsTo;
-  std::vector<std::pair<std::string, std::string>> attributeLinks; ///< (cell, attribute)
-};
-
-/// The structural state: what the parameter table cannot hold. Copied with every snapshot.
-struct Structure
-{
-  std::size_t active = kNone;
-  std::size_t previous = kNone;
-  bool justActivated = false;
-  double activatedAt = 0.0;
-  std::map<std::string, double> presentSince;
-  std::map<std::string, std::shared_ptr<const std::vector<ShapePart>>> shapes; ///< set by code
-  std::map<std::string, std::vector<double>> shapeParameters;
-  std::map<std::string, std::uint64_t> versions;
-  std::map<std::string, Value> texts; ///< non-numeric parameters (strings)
-};
 
 std::string reactionKey(const Procedure& p)
 {
@@ -189,145 +77,9 @@ std::uint64_t bitsOf(double d)
 
 } // namespace
 
-struct DynamicModel::Impl
-{
-  lang::IcmModel model;
-  RunOptions options;
-  std::string file;
-  Interpreter interpreter;
-  std::vector<CellSpec> cells;
-  std::map<std::string, std::size_t> cellIndex;
-  std::vector<InstanceSpec> instances;
-  std::map<std::string, std::size_t> instanceIndex;
-  std::map<std::string, dyn::AnimationCurve> curves[4]; ///< per component x, y, z, and scalar
-  std::set<std::string> curveNames;
-  std::map<std::string, std::size_t> curveWidth;
-  std::map<std::string, AttributeSpec> attributes;
-  std::vector<ParamSpec> modelParams;
-  std::vector<std::string> modelStateNames;
-  std::set<std::string> eventNames;
-  std::map<std::string, double> eventPriority;
-  std::map<std::string, std::vector<std::string>> eventParams;
-  std::map<std::string, dyn::TimeSpan> eventSpans;
-  std::map<std::string, dyn::TimeSpan> timespans;
-  dyn::ParameterTable table;
-  std::map<std::string, Value::Type> types; ///< qualified parameter -> type
-  std::unique_ptr<dyn::Stepper> stepper;
-  Structure s;
-  std::size_t graphInstance = kNone;
-  bool started = false;
-  std::size_t processedSeen = 0;
-  std::uint64_t nextVersion = 1;
-  dyn::StepContext* context = nullptr; ///< the frame being evaluated (events, TIME_REJECTED)
-
-  Impl(lang::IcmModel m, RunOptions o)
-    : model(std::move(m))
-    , options(std::move(o))
-    , file(model.fileName)
-    , interpreter(model.fileName, &model.functions)
-  {
-  }
-
-  [[noreturn]] void fail(Pos p, const std::string& message) const
-  {
-    throw ModelError(file, p, message);
-  }
-
-  // ---- building --------------------------------------------------------------------------
-  void build();
-  void buildTimespans();
-  void buildAnimations();
-  void buildEvents();
-  void buildCell(const CellDef& def);
-  void buildShape(CellSpec& c, const Property& p);
-  void buildInstance(const Instance& in);
-  std::vector<std::string> cellsOf(const Instance& in, int depth) const;
-  std::vector<RelationSpec> relationsOf(
-    const Instance& in, const std::string& kind, int depth) const;
-  RelationSpec relationSpec(const Relation& r) const;
-  void buildAttributes(const lang::icm::AttributesSection& section);
-  std::vector<std::pair<std::string, std::string>> attributeLinksOf(
-    const Instance& in, int depth) const;
-  void addParam(const std::string& owner, const ParamSpec& p);
-  Value initialValue(const ParamDecl& p);
-  void buildStepper();
-  dyn::DependencyGraph graph(std::size_t instance) const;
-
-  // ---- values ----------------------------------------------------------------------------
-  std::string qualified(const std::string& owner, const std::string& name) const
-  {
-    return owner.empty() ? name : owner + "." + name;
-  }
-  bool hasParam(const std::string& q) const { return types.count(q) > 0; }
-  Value get(const std::string& q) const;
-  void set(const std::string& q, const Value& v);
-
-  // ---- shapes ----------------------------------------------------------------------------
-  bool present(const std::string& cell) const
-  {
-    if (s.active == kNone)
-      return false;
-    const auto& cs = instances[s.active].cells;
-    return std::find(cs.begin(), cs.end(), cell) != cs.end();
-  }
-  std::shared_ptr<const std::vector<ShapePart>> partsOf(const CellSpec& c) const;
-  Affine localPlace(const std::string& cell) const;
-  Affine place(const std::string& cell, int depth = 0) const;
-  ShapePtr shapeOf(const std::string& cell, int depth = 0) const;
-  std::uint64_t versionOf(const std::string& cell, int depth = 0) const;
-  void bumpVersion(const std::string& cell) { s.versions[cell] = nextVersion++; }
-
-  // ---- running ---------------------------------------------------------------------------
-  const Procedure* procedureFor(const std::string& cell, const std::string& key) const;
-  void runCell(const std::string& cell, const std::string& key, dyn::StepContext& c,
-    const dyn::Event* ev = nullptr);
-  void runInstance(
-    std::size_t i, const std::string& key, dyn::StepContext& c, const dyn::Event* ev = nullptr);
-  void activate(dyn::StepContext& c);
-  std::vector<std::size_t> validInstances(double t);
-  void setActive(std::size_t i, double t);
-  FrameRecord record(double t, bool transition);
-  void step(double dt);
-  void settle();
-};
-
-// ---- scopes ---------------------------------------------------------------------------------
-
-namespace
-{
-
-/// What code inside a cell's, an instance's or the model's procedures sees.
-class EngineScope : public Scope
-{
-public:
-  EngineScope(DynamicModel::Impl& m, std::string cell, std::size_t instance)
-    : m_(m)
-    , cell_(std::move(cell))
-    , instance_(instance)
-  {
-  }
-
-  bool lookup(const std::string& name, Value& out) override;
-  bool member(const Value& base, const std::string& member, Value& out) override;
-  bool assign(const std::string& name, const std::string& member, const Value& v) override;
-  Value call(const std::string& name, const std::vector<Value>& args) override;
-
-private:
-  /// The qualified parameter a bare name stands for, or "".
-  std::string resolve(const std::string& name) const;
-  const AliasSpec* alias(const std::string& name) const;
-  ShapePtr cellShape(const Value& v) const;
-
-  DynamicModel::Impl& m_;
-  std::string cell_;
-  std::size_t instance_;
-};
-
-} // namespace
-
 // ---- building -----------------------------------------------------------------------------
 
-void DynamicModel::Impl::build()
+void ModelState::build()
 {
   buildTimespans();
   buildAnimations();
@@ -394,7 +146,7 @@ void DynamicModel::Impl::build()
   buildStepper();
 }
 
-void DynamicModel::Impl::buildTimespans()
+void ModelState::buildTimespans()
 {
   EngineScope scope(*this, {}, kNone);
   for (const auto& t : model.timespans)
@@ -430,7 +182,7 @@ void DynamicModel::Impl::buildTimespans()
   }
 }
 
-void DynamicModel::Impl::buildAnimations()
+void ModelState::buildAnimations()
 {
   EngineScope scope(*this, {}, kNone);
   for (const CellDef& a : model.animations)
@@ -490,7 +242,7 @@ void DynamicModel::Impl::buildAnimations()
   }
 }
 
-void DynamicModel::Impl::buildEvents()
+void ModelState::buildEvents()
 {
   for (const auto& e : model.events)
   {
@@ -510,7 +262,7 @@ void DynamicModel::Impl::buildEvents()
   }
 }
 
-void DynamicModel::Impl::buildCell(const CellDef& def)
+void ModelState::buildCell(const CellDef& def)
 {
   CellSpec c;
   // `B <- A`: a copy of A's properties, parameters and reactions, then B's own.
@@ -627,7 +379,7 @@ void DynamicModel::Impl::buildCell(const CellDef& def)
   cells.push_back(std::move(c));
 }
 
-void DynamicModel::Impl::buildShape(CellSpec& c, const Property& p)
+void ModelState::buildShape(CellSpec& c, const Property& p)
 {
   c.parts.clear();
   c.tape.reset();
@@ -771,7 +523,7 @@ void DynamicModel::Impl::buildShape(CellSpec& c, const Property& p)
   }
 }
 
-RelationSpec DynamicModel::Impl::relationSpec(const Relation& r) const
+RelationSpec ModelState::relationSpec(const Relation& r) const
 {
   RelationSpec s;
   s.pos = r.pos;
@@ -799,7 +551,7 @@ RelationSpec DynamicModel::Impl::relationSpec(const Relation& r) const
   return s;
 }
 
-std::vector<std::string> DynamicModel::Impl::cellsOf(const Instance& in, int depth) const
+std::vector<std::string> ModelState::cellsOf(const Instance& in, int depth) const
 {
   if (depth > 64)
     fail(in.pos, "templates derive from each other in a cycle");
@@ -845,7 +597,7 @@ std::vector<std::string> DynamicModel::Impl::cellsOf(const Instance& in, int dep
   return out;
 }
 
-std::vector<RelationSpec> DynamicModel::Impl::relationsOf(
+std::vector<RelationSpec> ModelState::relationsOf(
   const Instance& in, const std::string& kind, int depth) const
 {
   if (depth > 64)
@@ -884,7 +636,7 @@ std::vector<RelationSpec> DynamicModel::Impl::relationsOf(
   return out;
 }
 
-void DynamicModel::Impl::buildAttributes(const lang::icm::AttributesSection& section)
+void ModelState::buildAttributes(const lang::icm::AttributesSection& section)
 {
   for (const CellDef& d : section.defs)
   {
@@ -913,7 +665,7 @@ void DynamicModel::Impl::buildAttributes(const lang::icm::AttributesSection& sec
       attributes[b.first.text] = AttributeSpec{ b.first.text, nullptr, 3, b.second.text };
 }
 
-std::vector<std::pair<std::string, std::string>> DynamicModel::Impl::attributeLinksOf(
+std::vector<std::pair<std::string, std::string>> ModelState::attributeLinksOf(
   const Instance& in, int depth) const
 {
   if (depth > 64)
@@ -948,7 +700,7 @@ std::vector<std::pair<std::string, std::string>> DynamicModel::Impl::attributeLi
   return out;
 }
 
-void DynamicModel::Impl::buildInstance(const Instance& in)
+void ModelState::buildInstance(const Instance& in)
 {
   InstanceSpec s;
   s.name = in.name.text;
@@ -1011,7 +763,7 @@ void DynamicModel::Impl::buildInstance(const Instance& in)
 
 // `name : TYPE(value)` or `translation(x, y, z)`: the initial value, of the declared type.
 // Arrays and transforms have none (they only order dependencies).
-Value DynamicModel::Impl::initialValue(const ParamDecl& p)
+Value ModelState::initialValue(const ParamDecl& p)
 {
   EngineScope scope(*this, {}, kNone);
   auto number = [&](std::size_t i)
@@ -1047,7 +799,7 @@ Value DynamicModel::Impl::initialValue(const ParamDecl& p)
   }
 }
 
-void DynamicModel::Impl::addParam(const std::string& owner, const ParamSpec& p)
+void ModelState::addParam(const std::string& owner, const ParamSpec& p)
 {
   const std::string q = qualified(owner, p.name);
   if (types.count(q))
@@ -1070,7 +822,7 @@ void DynamicModel::Impl::addParam(const std::string& owner, const ParamSpec& p)
   }
 }
 
-dyn::DependencyGraph DynamicModel::Impl::graph(std::size_t i) const
+dyn::DependencyGraph ModelState::graph(std::size_t i) const
 {
   const InstanceSpec& in = instances[i];
   dyn::DependencyGraph g;
@@ -1125,7 +877,7 @@ dyn::DependencyGraph DynamicModel::Impl::graph(std::size_t i) const
   return g;
 }
 
-void DynamicModel::Impl::buildStepper()
+void ModelState::buildStepper()
 {
   stepper = std::make_unique<dyn::Stepper>(table, 0.0);
   dyn::StepperOptions so;
@@ -1216,7 +968,7 @@ void DynamicModel::Impl::buildStepper()
 
 // ---- values ---------------------------------------------------------------------------------
 
-Value DynamicModel::Impl::get(const std::string& q) const
+Value ModelState::get(const std::string& q) const
 {
   auto t = types.find(q);
   if (t == types.end())
@@ -1240,7 +992,7 @@ Value DynamicModel::Impl::get(const std::string& q) const
   }
 }
 
-void DynamicModel::Impl::set(const std::string& q, const Value& v)
+void ModelState::set(const std::string& q, const Value& v)
 {
   const Value::Type t = types.at(q);
   // std::runtime_error, not ModelError: the interpreter adds the place of the assignment.
@@ -1285,7 +1037,7 @@ void DynamicModel::Impl::set(const std::string& q, const Value& v)
 
 // ---- shapes ---------------------------------------------------------------------------------
 
-std::shared_ptr<const std::vector<ShapePart>> DynamicModel::Impl::partsOf(const CellSpec& c) const
+std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec& c) const
 {
   if (auto it = s.shapes.find(c.name); it != s.shapes.end())
     return it->second;
@@ -1296,7 +1048,7 @@ std::shared_ptr<const std::vector<ShapePart>> DynamicModel::Impl::partsOf(const 
   return parts;
 }
 
-Affine DynamicModel::Impl::localPlace(const std::string& cell) const
+Affine ModelState::localPlace(const std::string& cell) const
 {
   const dyn::ParameterTable& p = stepper->params();
   auto v = [&](const char* prop)
@@ -1307,7 +1059,7 @@ Affine DynamicModel::Impl::localPlace(const std::string& cell) const
   return Affine::fromTransform(v("translation"), v("rotation"), v("scale"));
 }
 
-Affine DynamicModel::Impl::place(const std::string& cell, int depth) const
+Affine ModelState::place(const std::string& cell, int depth) const
 {
   if (depth > static_cast<int>(cells.size()))
     throw std::runtime_error("HIERARCHICAL dependencies form a cycle through " + cell);
@@ -1321,7 +1073,7 @@ Affine DynamicModel::Impl::place(const std::string& cell, int depth) const
   return local;
 }
 
-ShapePtr DynamicModel::Impl::shapeOf(const std::string& cell, int depth) const
+ShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
 {
   if (depth > static_cast<int>(cells.size()))
     throw std::runtime_error("the shapes of blend/union cells refer to each other in a cycle");
@@ -1345,7 +1097,7 @@ ShapePtr DynamicModel::Impl::shapeOf(const std::string& cell, int depth) const
   return shape;
 }
 
-std::uint64_t DynamicModel::Impl::versionOf(const std::string& cell, int depth) const
+std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
 {
   const CellSpec& c = cells[cellIndex.at(cell)];
   std::uint64_t v = 0;
@@ -1368,8 +1120,7 @@ std::uint64_t DynamicModel::Impl::versionOf(const std::string& cell, int depth) 
 
 // ---- running --------------------------------------------------------------------------------
 
-const Procedure* DynamicModel::Impl::procedureFor(
-  const std::string& cell, const std::string& key) const
+const Procedure* ModelState::procedureFor(const std::string& cell, const std::string& key) const
 {
   if (s.active != kNone)
   {
@@ -1416,7 +1167,7 @@ std::vector<Value> timeArgs(
 
 } // namespace
 
-void DynamicModel::Impl::runCell(
+void ModelState::runCell(
   const std::string& cell, const std::string& key, dyn::StepContext& c, const dyn::Event* ev)
 {
   const Procedure* p = procedureFor(cell, key);
@@ -1445,7 +1196,7 @@ void DynamicModel::Impl::runCell(
   context = nullptr;
 }
 
-void DynamicModel::Impl::runInstance(
+void ModelState::runInstance(
   std::size_t i, const std::string& key, dyn::StepContext& c, const dyn::Event* ev)
 {
   auto it = instances[i].reactions.find(key);
@@ -1458,7 +1209,7 @@ void DynamicModel::Impl::runInstance(
   context = nullptr;
 }
 
-void DynamicModel::Impl::activate(dyn::StepContext& c)
+void ModelState::activate(dyn::StepContext& c)
 {
   if (!s.justActivated)
     return;
@@ -1482,7 +1233,7 @@ void DynamicModel::Impl::activate(dyn::StepContext& c)
       runCell(cell, "init", c);
 }
 
-std::vector<std::size_t> DynamicModel::Impl::validInstances(double t)
+std::vector<std::size_t> ModelState::validInstances(double t)
 {
   std::vector<std::size_t> valid;
   for (std::size_t i = 0; i < instances.size(); ++i)
@@ -1509,7 +1260,7 @@ std::vector<std::size_t> DynamicModel::Impl::validInstances(double t)
   return valid;
 }
 
-void DynamicModel::Impl::setActive(std::size_t i, double t)
+void ModelState::setActive(std::size_t i, double t)
 {
   s.previous = s.active;
   const auto* before = s.active != kNone ? &instances[s.active].cells : nullptr;
@@ -1523,7 +1274,7 @@ void DynamicModel::Impl::setActive(std::size_t i, double t)
   graphInstance = i;
 }
 
-FrameRecord DynamicModel::Impl::record(double t, bool transition)
+FrameRecord ModelState::record(double t, bool transition)
 {
   FrameRecord r;
   r.time = t;
@@ -1550,7 +1301,7 @@ FrameRecord DynamicModel::Impl::record(double t, bool transition)
   return r;
 }
 
-void DynamicModel::Impl::step(double dt)
+void ModelState::step(double dt)
 {
   try
   {
@@ -1566,7 +1317,7 @@ void DynamicModel::Impl::step(double dt)
   }
 }
 
-void DynamicModel::Impl::settle()
+void ModelState::settle()
 {
   try
   {
@@ -1579,11 +1330,6 @@ void DynamicModel::Impl::settle()
 }
 
 // ---- EngineScope ----------------------------------------------------------------------------
-
-namespace
-{
-
-const char* const kProperties[] = { "translation", "rotation", "scale" };
 
 std::string EngineScope::resolve(const std::string& name) const
 {
@@ -1741,130 +1487,209 @@ ShapePtr EngineScope::cellShape(const Value& v) const
   return m_.shapeOf(v.text);
 }
 
-Value EngineScope::call(const std::string& name, const std::vector<Value>& args)
+namespace
 {
-  const QueryOptions& q = m_.options.geometry;
-  if (name == "distance")
-    return Value::real(engine::distance(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
-  if (name == "intersects")
-    return Value::boolean(engine::intersects(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
-  if (name == "contains")
-    return Value::boolean(engine::contains(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
-  if (name == "intersectionCount")
-    return Value::integer(static_cast<double>(
-      intersectionPoints(*cellShape(args.at(0)), *cellShape(args.at(1)), q).size()));
-  if (name == "intersectionPoint")
-  {
-    const auto pts = intersectionPoints(*cellShape(args.at(0)), *cellShape(args.at(1)), q);
-    const double i = args.at(2).number;
-    if (!(i >= 0) || i >= static_cast<double>(pts.size()))
-      throw std::runtime_error("index " + std::to_string(static_cast<long long>(i)) +
-        " out of range: the cells meet in " + std::to_string(pts.size()) + " point(s)");
-    return Value::vector(pts[static_cast<std::size_t>(i)]);
-  }
-  if (name == "intersectionArea")
-    return Value::real(intersectionMeasure(*cellShape(args.at(0)), *cellShape(args.at(1)), q));
-  if (name == "segment" || name == "arc" || name == "circularSegment")
-  {
-    ShapePart p;
-    p.kind = name == "segment" ? ShapePart::Kind::Segment
-      : name == "arc"          ? ShapePart::Kind::Arc
-                               : ShapePart::Kind::CircularSegment;
-    for (std::size_t i = 0; i < 2; ++i)
-      if (args.at(i).type != Value::Type::Vec3)
-        throw std::runtime_error("argument " + std::to_string(i + 1) + " must be a vec3");
-    p.points = { args[0].vec, args[1].vec };
-    if (name != "segment")
-      p.radius = args.at(2).number;
-    Value v;
-    v.type = Value::Type::Shape;
-    v.shape = std::make_shared<const std::vector<ShapePart>>(std::vector<ShapePart>{ p });
-    return v;
-  }
-  if (name == "setShapeParameter")
-  {
-    const Value& cell = args.at(0);
-    if (cell.type != Value::Type::Cell)
-      throw std::runtime_error("the first argument is a cell");
-    const CellSpec& c = m_.cells[m_.cellIndex.at(cell.text)];
-    if (!c.tape)
-      throw std::runtime_error("the cell " + cell.text + " has no HyperFun or XML shape");
-    // "a[2]" or "a2": HyperFun's parameter array, counted from 1.
-    std::string key = args.at(1).text;
-    key.erase(std::remove_if(key.begin(), key.end(),
-                [](char ch) { return ch == '[' || ch == ']' || ch == 'a'; }),
-      key.end());
-    char* end = nullptr;
-    const long index = std::strtol(key.c_str(), &end, 10);
-    if (key.empty() || *end != '\0' || index < 1 || index > c.parameterCount)
-      throw std::runtime_error("the shape of " + cell.text + " has the parameters a[1] to a[" +
-        std::to_string(c.parameterCount) + "], not '" + args.at(1).text + "'");
-    auto& values = m_.s.shapeParameters[cell.text];
-    if (values.empty())
-      values.assign(static_cast<std::size_t>(c.parameterCount), 0.0);
-    const double v = args.at(2).number;
-    if (!std::isfinite(v))
-      throw std::runtime_error("the value is not finite");
-    if (values[static_cast<std::size_t>(index - 1)] != v)
-    {
-      values[static_cast<std::size_t>(index - 1)] = v;
-      m_.bumpVersion(cell.text);
-    }
-    return {};
-  }
-  if (name == "fireEvent")
-  {
-    const std::string ev = args.at(0).text;
-    if (ev == "TIME_REJECTED")
-    {
-      if (!m_.context)
-        throw std::runtime_error("TIME_REJECTED outside a frame (in a predicate?)");
-      m_.context->rejectTime(args.size() > 1 ? args[1].number : kNaN);
-      return {};
-    }
-    if (!m_.eventNames.count(ev))
-      throw std::runtime_error("unknown event " + ev);
-    const auto& names = m_.eventParams.at(ev);
-    if (args.size() - 1 != names.size())
-      throw std::runtime_error(ev + " has " + std::to_string(names.size()) + " parameter(s)");
-    std::map<std::string, double> params;
-    for (std::size_t i = 0; i < names.size(); ++i)
-      params[names[i]] = args[i + 1].number;
-    const double now = m_.context ? m_.context->globalT : m_.stepper->time();
-    dyn::Event e = dyn::Event::at(ev, now, m_.eventPriority.at(ev), params);
-    if (m_.context)
-      m_.context->fireEvent(e);
-    else
-      m_.stepper->fireEvent(e);
-    return {};
-  }
-  if (name == "animation" || name == "animationValue" || name == "animationDuration")
-  {
-    const std::string curve = args.at(0).text;
-    if (!m_.curveNames.count(curve))
-      throw std::runtime_error("unknown animation \"" + curve + "\"");
-    const std::size_t width = m_.curveWidth.at(curve);
-    if (name == "animationDuration")
-    {
-      const auto& c = width == 2 ? m_.curves[3].at(curve) : m_.curves[0].at(curve);
-      return Value::real(c.duration());
-    }
-    const double t = args.at(1).number;
-    if (name == "animationValue")
-    {
-      if (width != 2)
-        throw std::runtime_error("\"" + curve + "\" is a vector animation: use animation()");
-      return Value::real(m_.curves[3].at(curve).evaluate(t));
-    }
-    if (width != 4)
-      throw std::runtime_error("\"" + curve + "\" is a scalar animation: use animationValue()");
-    return Value::vector({ m_.curves[0].at(curve).evaluate(t), m_.curves[1].at(curve).evaluate(t),
-      m_.curves[2].at(curve).evaluate(t) });
-  }
-  throw std::runtime_error("unknown function '" + name + "'");
+
+/// A call of a Library built-in: the model it runs in, through the calling code's scope.
+struct LibraryCall
+{
+  const lang::icm::Builtin& builtin;
+  EngineScope& scope;
+  ModelState& m;
+  const std::vector<Value>& args;
+};
+
+using LibraryFunction = Value (*)(const LibraryCall&);
+using lang::icm::BuiltinId;
+
+Value distanceOf(const LibraryCall& c)
+{
+  return Value::real(engine::distance(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
 }
 
+Value intersectsOf(const LibraryCall& c)
+{
+  return Value::boolean(engine::intersects(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
+}
+
+Value containsOf(const LibraryCall& c)
+{
+  return Value::boolean(engine::contains(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
+}
+
+Value intersectionCountOf(const LibraryCall& c)
+{
+  return Value::integer(static_cast<double>(intersectionPoints(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry)
+                                              .size()));
+}
+
+Value intersectionPointOf(const LibraryCall& c)
+{
+  const auto pts = intersectionPoints(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry);
+  const double i = c.args.at(2).number;
+  if (!(i >= 0) || i >= static_cast<double>(pts.size()))
+    throw std::runtime_error("index " + std::to_string(static_cast<long long>(i)) +
+      " out of range: the cells meet in " + std::to_string(pts.size()) + " point(s)");
+  return Value::vector(pts[static_cast<std::size_t>(i)]);
+}
+
+Value intersectionAreaOf(const LibraryCall& c)
+{
+  return Value::real(intersectionMeasure(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
+}
+
+/// segment(p, q), arc(p, q, r), circularSegment(p, q, r): a shape part in local coordinates.
+Value shapePartOf(const LibraryCall& c)
+{
+  const BuiltinId id = c.builtin.id;
+  ShapePart p;
+  p.kind = id == BuiltinId::Segment ? ShapePart::Kind::Segment
+    : id == BuiltinId::Arc          ? ShapePart::Kind::Arc
+                                    : ShapePart::Kind::CircularSegment;
+  for (std::size_t i = 0; i < 2; ++i)
+    if (c.args.at(i).type != Value::Type::Vec3)
+      throw std::runtime_error("argument " + std::to_string(i + 1) + " must be a vec3");
+  p.points = { c.args[0].vec, c.args[1].vec };
+  if (id != BuiltinId::Segment)
+    p.radius = c.args.at(2).number;
+  Value v;
+  v.type = Value::Type::Shape;
+  v.shape = std::make_shared<const std::vector<ShapePart>>(std::vector<ShapePart>{ p });
+  return v;
+}
+
+Value setShapeParameter(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const std::vector<Value>& args = call.args;
+  const Value& cell = args.at(0);
+  if (cell.type != Value::Type::Cell)
+    throw std::runtime_error("the first argument is a cell");
+  const CellSpec& c = m.cells[m.cellIndex.at(cell.text)];
+  if (!c.tape)
+    throw std::runtime_error("the cell " + cell.text + " has no HyperFun or XML shape");
+  // "a[2]" or "a2": HyperFun's parameter array, counted from 1.
+  std::string key = args.at(1).text;
+  key.erase(std::remove_if(
+              key.begin(), key.end(), [](char ch) { return ch == '[' || ch == ']' || ch == 'a'; }),
+    key.end());
+  char* end = nullptr;
+  const long index = std::strtol(key.c_str(), &end, 10);
+  if (key.empty() || *end != '\0' || index < 1 || index > c.parameterCount)
+    throw std::runtime_error("the shape of " + cell.text + " has the parameters a[1] to a[" +
+      std::to_string(c.parameterCount) + "], not '" + args.at(1).text + "'");
+  auto& values = m.s.shapeParameters[cell.text];
+  if (values.empty())
+    values.assign(static_cast<std::size_t>(c.parameterCount), 0.0);
+  const double v = args.at(2).number;
+  if (!std::isfinite(v))
+    throw std::runtime_error("the value is not finite");
+  if (values[static_cast<std::size_t>(index - 1)] != v)
+  {
+    values[static_cast<std::size_t>(index - 1)] = v;
+    m.bumpVersion(cell.text);
+  }
+  return {};
+}
+
+Value fireEvent(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const std::vector<Value>& args = call.args;
+  const std::string ev = args.at(0).text;
+  if (ev == "TIME_REJECTED")
+  {
+    if (!m.context)
+      throw std::runtime_error("TIME_REJECTED outside a frame (in a predicate?)");
+    m.context->rejectTime(args.size() > 1 ? args[1].number : kNaN);
+    return {};
+  }
+  if (!m.eventNames.count(ev))
+    throw std::runtime_error("unknown event " + ev);
+  const auto& names = m.eventParams.at(ev);
+  if (args.size() - 1 != names.size())
+    throw std::runtime_error(ev + " has " + std::to_string(names.size()) + " parameter(s)");
+  std::map<std::string, double> params;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    params[names[i]] = args[i + 1].number;
+  const double now = m.context ? m.context->globalT : m.stepper->time();
+  dyn::Event e = dyn::Event::at(ev, now, m.eventPriority.at(ev), params);
+  if (m.context)
+    m.context->fireEvent(e);
+  else
+    m.stepper->fireEvent(e);
+  return {};
+}
+
+/// animation(curve, t), animationValue(curve, t), animationDuration(curve).
+Value animationOf(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const BuiltinId id = call.builtin.id;
+  const std::string curve = call.args.at(0).text;
+  if (!m.curveNames.count(curve))
+    throw std::runtime_error("unknown animation \"" + curve + "\"");
+  const std::size_t width = m.curveWidth.at(curve);
+  if (id == BuiltinId::AnimationDuration)
+  {
+    const auto& c = width == 2 ? m.curves[3].at(curve) : m.curves[0].at(curve);
+    return Value::real(c.duration());
+  }
+  const double t = call.args.at(1).number;
+  if (id == BuiltinId::AnimationValue)
+  {
+    if (width != 2)
+      throw std::runtime_error("\"" + curve + "\" is a vector animation: use animation()");
+    return Value::real(m.curves[3].at(curve).evaluate(t));
+  }
+  if (width != 4)
+    throw std::runtime_error("\"" + curve + "\" is a scalar animation: use animationValue()");
+  return Value::vector({ m.curves[0].at(curve).evaluate(t), m.curves[1].at(curve).evaluate(t),
+    m.curves[2].at(curve).evaluate(t) });
+}
+
+/// The running model's half of the built-in library (the Library entries of
+/// lang::icm::builtins()).
+const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
+  { BuiltinId::Distance, distanceOf },
+  { BuiltinId::Intersects, intersectsOf },
+  { BuiltinId::Contains, containsOf },
+  { BuiltinId::IntersectionCount, intersectionCountOf },
+  { BuiltinId::IntersectionPoint, intersectionPointOf },
+  { BuiltinId::IntersectionArea, intersectionAreaOf },
+  { BuiltinId::FireEvent, fireEvent },
+  { BuiltinId::Animation, animationOf },
+  { BuiltinId::AnimationValue, animationOf },
+  { BuiltinId::AnimationDuration, animationOf },
+  { BuiltinId::Segment, shapePartOf },
+  { BuiltinId::Arc, shapePartOf },
+  { BuiltinId::CircularSegment, shapePartOf },
+  { BuiltinId::SetShapeParameter, setShapeParameter },
+};
+
 } // namespace
+
+std::vector<lang::icm::BuiltinId> libraryBuiltins()
+{
+  std::vector<BuiltinId> ids;
+  for (const auto& entry : kLibrary)
+    ids.push_back(entry.first);
+  return ids;
+}
+
+Value EngineScope::call(const lang::icm::Builtin& builtin, const std::vector<Value>& args)
+{
+  for (const auto& [id, fn] : kLibrary)
+    if (id == builtin.id)
+      return fn(LibraryCall{ builtin, *this, m_, args });
+  throw std::runtime_error(std::string("unknown function '") + builtin.call.name + "'");
+}
 
 // ---- DynamicModel ---------------------------------------------------------------------------
 
@@ -1874,7 +1699,7 @@ DynamicModel DynamicModel::load(const std::string& path, RunOptions options)
 }
 
 DynamicModel::DynamicModel(lang::IcmModel model, RunOptions options)
-  : impl_(std::make_unique<Impl>(std::move(model), std::move(options)))
+  : impl_(std::make_unique<ModelState>(std::move(model), std::move(options)))
 {
   impl_->build();
 }
@@ -1917,7 +1742,7 @@ const std::string& DynamicModel::activeInstance() const
 
 FrameRecord DynamicModel::start()
 {
-  Impl& m = *impl_;
+  ModelState& m = *impl_;
   if (m.started)
     return m.record(time(), false);
   m.started = true;
@@ -1959,7 +1784,7 @@ FrameRecord DynamicModel::start()
 
 std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
 {
-  Impl& m = *impl_;
+  ModelState& m = *impl_;
   if (!std::isfinite(t) || !(maxStep > 0.0) || !std::isfinite(maxStep))
     throw std::invalid_argument("advanceTo: the time and the step must be finite, the step > 0");
   if (t < time())
@@ -2075,7 +1900,7 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
 
 std::vector<CellState> DynamicModel::cells() const
 {
-  const Impl& m = *impl_;
+  const ModelState& m = *impl_;
   std::vector<CellState> out;
   if (m.s.active == kNone)
     return out;
@@ -2097,7 +1922,7 @@ std::vector<CellState> DynamicModel::cells() const
 
 complex::Complex DynamicModel::complex() const
 {
-  const Impl& m = *impl_;
+  const ModelState& m = *impl_;
   complex::Complex cx;
   std::map<std::string, complex::CellId> ids;
   for (const CellState& c : cells())
@@ -2172,7 +1997,7 @@ complex::Complex DynamicModel::complex() const
 
 Value DynamicModel::value(const std::string& path) const
 {
-  Impl& m = *impl_;
+  ModelState& m = *impl_;
   if (m.hasParam(path))
     return m.get(path);
   const auto dot = path.find('.');
@@ -2216,7 +2041,7 @@ const std::vector<std::string>& DynamicModel::log() const
 
 std::vector<std::vector<std::string>> DynamicModel::evaluationOrder() const
 {
-  const Impl& m = *impl_;
+  const ModelState& m = *impl_;
   if (m.s.active == kNone)
     return {};
   dyn::DependencyGraph g = m.graph(m.s.active);

@@ -5,6 +5,7 @@
 // loop bounds).
 #include "Lang/HyperFun.h"
 #include "Lang/Icm.h"
+#include "Lang/IcmBuiltins.h"
 #include "Lang/IcmLexer.h"
 
 #include <cmath>
@@ -899,7 +900,7 @@ private:
         "disk(r)");
       return;
     }
-    const Builtin* b = findShapeBuiltin(v->text);
+    const Signature* b = findShapeBuiltin(v->text);
     const int n = static_cast<int>(v->kids.size()) - 1;
     if (!b)
     {
@@ -955,7 +956,7 @@ private:
     }
   }
 
-  static std::string arity(const Builtin& b)
+  static std::string arity(const Signature& b)
   {
     if (b.maxArgs < 0)
     {
@@ -2284,8 +2285,8 @@ private:
       valueType(uf->second->resultType, t);
       return t;
     }
-    const Builtin* b = findBuiltin(fn);
-    if (!b)
+    const Builtin* builtin = findBuiltin(fn);
+    if (!builtin)
     {
       err(e.pos, "unknown function '" + e.text + "' (not a built-in nor a model function)");
       for (std::size_t i = 1; i < e.kids.size(); ++i)
@@ -2294,6 +2295,7 @@ private:
       }
       return Ty::Unknown;
     }
+    const Signature* b = &builtin->call;
     if (static_cast<int>(n) < b->minArgs || (b->maxArgs >= 0 && static_cast<int>(n) > b->maxArgs))
     {
       err(e.pos,
