@@ -518,3 +518,50 @@ TEST(Docs, IcmBuiltins)
     << "docs/icm.md's built-ins differ from Lang/IcmBuiltins.cxx; the table's rows should be:\n"
     << ictk::lang::icm::builtinsMarkdown();
 }
+
+// An instance's cells are its template's minus the removed plus the added, in the template's order
+// then the added ones' (thesis L1459, I_j = TI \ {...} U {...}).
+TEST(EngineInstances, CellsDeriveFromTheTemplate)
+{
+  // EGG_GOING_DOWN = TEMPLATE_IC1.CELLS \ { Melting_egg } + Eggshell (App. C).
+  DynamicModel m = load("andyhausen.icm");
+  m.start();
+  std::vector<std::string> names;
+  for (const auto& c : m.cells())
+    names.push_back(c.name);
+  const std::vector<std::string> expected = { "Handle1", "Handle2", "Barrel", "Rope", "Hook",
+    "Egg_contents", "Liquid", "Eggshell" };
+  EXPECT_EQ(names, expected);
+
+  DynamicModel d = fromText("CELLS { A { shape = disk(1); dim = 2D; }\n"
+                            "  B { shape = disk(2); dim = 2D; }\n"
+                            "  C { shape = disk(3); dim = 2D; } }\n"
+                            "T : TEMPLATE_IC { CELLS { A B; } }\n"
+                            "I { CELLS { USE T.CELLS \\ { A } U { C }; } }\n");
+  d.start();
+  names.clear();
+  for (const auto& c : d.cells())
+    names.push_back(c.name);
+  EXPECT_EQ(names, (std::vector<std::string>{ "B", "C" }));
+}
+
+// Exactly one instance is valid at a time (L1394-1396): two valid ones are an error naming both.
+TEST(EngineErrors, SeveralValidInstancesAreNamed)
+{
+  const std::string text = "CELLS { A { shape = disk(1); dim = 2D; } }\n"
+                           "K : TEMPLATE_IC { CELLS { A; } }\n"
+                           "ONE : K { }\n"
+                           "TWO : K { PREDICATE { bool evaluate(REAL g, REAL l, REAL dt) { "
+                           "return A.translation.x < 1.0; } } }\n";
+  DynamicModel m = fromText(text);
+  try
+  {
+    m.start();
+    FAIL() << "expected a ModelError";
+  }
+  catch (const ModelError& e)
+  {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("several instances are valid: ONE, TWO"), std::string::npos) << what;
+  }
+}
