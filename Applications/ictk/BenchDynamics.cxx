@@ -1,31 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "BenchDynamics.h"
+#include "Progress.h"
 
 #include "Engine/CoherentDiscretizer.h"
 #include "Engine/DynamicModel.h"
 
 #include <chrono>
-#include <ctime>
 
-namespace ictk::app
+namespace ictk::cli
 {
-namespace
-{
-
-double CpuSeconds()
-{
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-double Since(std::chrono::steady_clock::time_point t0)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-} // namespace
-
 DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, int divisions,
   bool coherent, int runs, int threads)
 {
@@ -45,7 +28,7 @@ DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, i
     options.featureSize = complex::defaultFeatureSize(model.complex()) * 64.0 / divisions;
     engine::CoherentDiscretizer mesher(options);
     const double start = model.time();
-    engineSeconds += Since(mark);
+    engineSeconds += Seconds(mark);
     std::size_t points = 0;
     std::vector<std::string> instances;
     for (int k = 0; k <= steps; ++k)
@@ -56,7 +39,7 @@ DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, i
       {
         model.advanceTo(t, (t1 - start) / steps);
       }
-      engineSeconds += Since(mark);
+      engineSeconds += Seconds(mark);
       if (instances.empty() || instances.back() != model.activeInstance())
       {
         instances.push_back(model.activeInstance());
@@ -67,7 +50,7 @@ DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, i
         points += m.vertices().size();
       }
     }
-    out.seconds.push_back(Since(t0));
+    out.seconds.push_back(Seconds(t0));
     out.cpuSeconds.push_back(CpuSeconds() - c0);
     out.engineSeconds = engineSeconds;
     out.meshSeconds = mesher.total().seconds;
@@ -82,4 +65,4 @@ DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, i
   return out;
 }
 
-} // namespace ictk::app
+} // namespace ictk::cli

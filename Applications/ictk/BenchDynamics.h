@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace ictk::app
+namespace ictk::cli
 {
 
 struct DynamicRunTiming
@@ -29,4 +29,4 @@ struct DynamicRunTiming
 DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, int divisions,
   bool coherent, int runs, int threads);
 
-} // namespace ictk::app
+} // namespace ictk::cli

@@ -9,6 +9,7 @@
 // the contourer asks for. Pruned work should grow with the surface (r^2 in 3D, r in 2D), not with
 // the volume.
 #include "BenchScaling.h"
+#include "Progress.h"
 
 #include "Discretize/Surface.h"
 #include "FRep/BundledModels.h"
@@ -32,7 +33,7 @@
 #include <utility>
 #include <vector>
 
-namespace ictk::app
+namespace ictk::cli
 {
 
 namespace
@@ -46,26 +47,12 @@ std::vector<int> PrimitiveCounts{ 6, 62, 628, 7940 };
 constexpr std::uint32_t ScalingSeed = 20240611u; // random1000's seed
 constexpr double BoxHalf = 1.2;                  // the models' box: [-1.2, 1.2]^3
 
-double CpuNow()
-{
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 struct Timing
 {
   double wall = 0; ///< seconds, median
   double cpu = 0;  ///< process CPU seconds, median
   int runs = 0;
 };
-
-double MedianOf(std::vector<double> v)
-{
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /// A first run; when it took more than a second it is the only one, otherwise it is a warm-up
 /// and `runs` timed runs follow (medians reported).
@@ -74,12 +61,11 @@ Timing Measure(int runs, const std::function<void()>& f)
   std::vector<double> wall, cpu;
   auto once = [&]
   {
-    const double c0 = CpuNow();
+    const double c0 = CpuSeconds();
     const auto t0 = std::chrono::steady_clock::now();
     f();
-    const auto t1 = std::chrono::steady_clock::now();
-    wall.push_back(std::chrono::duration<double>(t1 - t0).count());
-    cpu.push_back(CpuNow() - c0);
+    wall.push_back(Seconds(t0));
+    cpu.push_back(CpuSeconds() - c0);
   };
   once();
   if (wall.front() <= 1.0)
@@ -91,7 +77,7 @@ Timing Measure(int runs, const std::function<void()>& f)
       once();
     }
   }
-  return { MedianOf(wall), MedianOf(cpu), static_cast<int>(wall.size()) };
+  return { Median(wall), Median(cpu), static_cast<int>(wall.size()) };
 }
 
 // --- counting field (what the contourer asks for) ------------------------------------------------
@@ -552,4 +538,4 @@ int RunScalingBench(int runs, int threads, bool json, bool quick)
   return 0;
 }
 
-} // namespace ictk::app
+} // namespace ictk::cli

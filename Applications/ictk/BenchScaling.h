@@ -6,7 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
-namespace ictk::app
+namespace ictk::cli
 {
 
 /// Adds --scaling (and its options) to the `bench` subcommand.
@@ -16,4 +16,4 @@ bool ScalingRequested();
 /// Prints the scaling tables (or JSON); returns the exit code. `threads` 0 means 1 thread.
 int RunScalingBench(int runs, int threads, bool json, bool quick);
 
-} // namespace ictk::app
+} // namespace ictk::cli

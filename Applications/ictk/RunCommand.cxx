@@ -1,5 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "RunCommand.h"
+// `ictk run`: runs a dynamic implicit complex (.icm) over a range of times and writes a .pvd time
+// series of its discretised complexes (one .vtpc per frame), optionally with a JSON-lines trace
+// of every evaluated time.
+#include "Command.h"
+#include "Options.h"
+#include "Progress.h"
 
 #include "Engine/CoherentDiscretizer.h"
 #include "Engine/DynamicModel.h"
@@ -18,14 +23,9 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <csignal>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -41,21 +41,19 @@ namespace
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-/// More frames than anyone can look at; a spec asking for them is a typo (a missing digit in DT).
-constexpr double MaxFrames = 1e6;
-constexpr int ExitInterrupted = 130;
-
-double Seconds(Clock::time_point since)
+struct RunModelOptions
 {
-  return std::chrono::duration<double>(Clock::now() - since).count();
-}
-
-bool EndsWith(std::string s, const std::string& suffix)
-{
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s.size() >= suffix.size() &&
-    s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
+  std::string Model;
+  std::string Frames;                    ///< T0:T1:DT
+  std::string FramesOption = "--frames"; ///< the name it was given under, for messages
+  std::string Output;
+  std::string Trace;
+  double FeatureSize = 0;
+  double MaxStep = 0;
+  bool NoCoherence = false;
+  bool Json = false;
+  int Threads = 0;
+};
 
 /// The engine's errors in the front ends' form (file:line:col, the source line and a caret), so
 /// that a model that reads but does not build reports like one that does not read.
@@ -77,77 +75,6 @@ lang::ParseError AsParseError(const engine::ModelError& e)
   }
   return lang::ParseError({ d });
 }
-
-std::atomic<bool> Interrupted{ false };
-
-extern "C" void OnRunInterrupt(int)
-{
-  Interrupted = true;
-}
-
-/// Installs the Ctrl-C handler for the run and restores the previous one.
-class InterruptScope
-{
-public:
-  InterruptScope()
-  {
-    Interrupted = false;
-    previousInt_ = std::signal(SIGINT, OnRunInterrupt);
-    previousTerm_ = std::signal(SIGTERM, OnRunInterrupt);
-  }
-  ~InterruptScope()
-  {
-    std::signal(SIGINT, previousInt_);
-    std::signal(SIGTERM, previousTerm_);
-  }
-  InterruptScope(const InterruptScope&) = delete;
-  InterruptScope& operator=(const InterruptScope&) = delete;
-
-private:
-  void (*previousInt_)(int) = SIG_DFL;
-  void (*previousTerm_)(int) = SIG_DFL;
-};
-
-/// A bar on a terminal, nothing otherwise (logs and pipes get the summary only).
-class ProgressBar
-{
-public:
-  explicit ProgressBar(bool enabled)
-    : enabled_(enabled && ::isatty(STDERR_FILENO) != 0)
-  {
-  }
-  void show(double fraction, std::size_t frame, std::size_t frames)
-  {
-    if (!enabled_)
-    {
-      return;
-    }
-    const int percent = static_cast<int>(std::floor(std::clamp(fraction, 0.0, 1.0) * 100));
-    if (percent == last_ && frame == lastFrame_)
-    {
-      return;
-    }
-    constexpr int Width = 40;
-    const int filled = percent * Width / 100;
-    std::cerr << "\rrun [" << std::string(filled, '#') << std::string(Width - filled, ' ') << "] "
-              << std::setw(3) << percent << "% frame " << frame << "/" << frames << std::flush;
-    last_ = percent;
-    lastFrame_ = frame;
-  }
-  void end()
-  {
-    if (enabled_ && last_ >= 0)
-    {
-      std::cerr << "\n";
-    }
-    last_ = -1;
-  }
-
-private:
-  bool enabled_;
-  int last_ = -1;
-  std::size_t lastFrame_ = 0;
-};
 
 std::string TraceLine(const engine::FrameRecord& r)
 {
@@ -174,7 +101,7 @@ bool IsFrameEntry(const fs::directory_entry& entry, const std::string& stem)
     return false;
   }
   name = name.substr(prefix.size());
-  if (entry.is_regular_file() && EndsWith(name, ".vtpc"))
+  if (entry.is_regular_file() && HasExtension(name, ".vtpc"))
   {
     name = name.substr(0, name.size() - 5);
   }
@@ -201,7 +128,7 @@ struct Outputs
 
   Outputs(const std::string& output, const std::string& trace)
   {
-    if (!EndsWith(output, ".pvd"))
+    if (!HasExtension(output, ".pvd"))
     {
       throw std::invalid_argument("-o: '" + output + "' is not a .pvd file");
     }
@@ -339,122 +266,16 @@ struct Transition
 
 } // namespace
 
-std::vector<double> ParseTimeSpec(const std::string& spec)
-{
-  std::vector<std::string> fields;
-  std::string::size_type start = 0;
-  while (true)
-  {
-    const auto colon = spec.find(':', start);
-    fields.push_back(spec.substr(start, colon == std::string::npos ? colon : colon - start));
-    if (colon == std::string::npos)
-    {
-      break;
-    }
-    start = colon + 1;
-  }
-  if (fields.size() != 3)
-  {
-    throw std::invalid_argument("--time: expected T0:T1:DT (e.g. 0:10:0.1), got '" + spec + "'");
-  }
-  static const char* const names[3] = { "T0", "T1", "DT" };
-  double v[3];
-  for (int i = 0; i < 3; ++i)
-  {
-    std::string field = fields[static_cast<std::size_t>(i)];
-    field.erase(0, field.find_first_not_of(" \t"));
-    field.erase(field.find_last_not_of(" \t") + 1);
-    errno = 0;
-    char* end = nullptr;
-    v[i] = std::strtod(field.c_str(), &end);
-    if (field.empty() || end == field.c_str() || *end != '\0')
-    {
-      throw std::invalid_argument(
-        std::string("--time: ") + names[i] + " is not a number: '" + field + "' in '" + spec + "'");
-    }
-    if (!std::isfinite(v[i]) || errno == ERANGE)
-    {
-      throw std::invalid_argument(
-        std::string("--time: ") + names[i] + " must be a finite number, got '" + field + "'");
-    }
-  }
-  const double t0 = v[0], t1 = v[1], dt = v[2];
-  if (t1 < t0)
-  {
-    throw std::invalid_argument("--time: T1 < T0 in '" + spec + "' (time runs forwards)");
-  }
-  if (!(dt > 0))
-  {
-    throw std::invalid_argument("--time: DT must be positive, got '" + fields[2] + "'");
-  }
-  const double count = std::floor((t1 - t0) / dt + 1e-3);
-  if (!(count + 1 <= MaxFrames))
-  {
-    std::ostringstream os;
-    os << "--time: '" << spec << "' gives " << std::setprecision(3) << count + 1
-       << " frames, more than the limit of 1000000 (a larger DT?)";
-    throw std::invalid_argument(os.str());
-  }
-  std::vector<double> times;
-  const auto n = static_cast<long long>(count);
-  times.reserve(static_cast<std::size_t>(n + 2));
-  for (long long k = 0; k <= n; ++k)
-  {
-    // By multiplication, not accumulation: frame k is at T0 + k DT to the last bit.
-    times.push_back(t0 + static_cast<double>(k) * dt);
-  }
-  if (std::abs(t1 - times.back()) < 1e-3 * dt)
-  {
-    times.back() = t1;
-  }
-  else if (times.back() < t1)
-  {
-    times.push_back(t1);
-  }
-  return times;
-}
-
-CLI::App* AddRunCommand(CLI::App& app, RunModelOptions& o)
-{
-  CLI::App* run = app.add_subcommand("run",
-    "Run a dynamic implicit complex (.icm) and write its discretised complex at every frame as a "
-    ".pvd time series (one .vtpc per frame)");
-  run->add_option("model", o.Model, "The .icm model")->required();
-  run->add_option("--time", o.Time, "Frames T0:T1:DT, e.g. 0:10:0.1 (T1 included)")->required();
-  run
-    ->add_option("-o,--output", o.Output,
-      "The .pvd file; the frames go into a folder named after it, beside it")
-    ->required();
-  run->add_option("--trace", o.Trace,
-    "Also write a JSON-lines trace: one object per evaluated time (frames and located "
-    "transitions) with time, instance, transition, events and state");
-  run->add_option("--size,--feature-size", o.FeatureSize,
-    "Mesh edge length and curve step, the same for every frame (default: 1/64 of the complex's "
-    "size at the model's start)");
-  run->add_option("--max-step", o.MaxStep, "The engine's largest time step (default: DT)");
-  run->add_flag("--no-coherence", o.NoCoherence,
-    "Re-mesh every cell of every frame instead of moving the meshes of unchanged cells");
-  run->add_option("--threads", o.Threads, "Threads for the discretisers (default: all cores)");
-  run->add_flag("--json", o.Json, "Print the summary as JSON");
-  return run;
-}
-
 int RunModel(const RunModelOptions& o)
 {
-  const std::vector<double> times = ParseTimeSpec(o.Time);
-  if (!std::isfinite(o.FeatureSize) || o.FeatureSize < 0)
-  {
-    throw std::invalid_argument("--size must be a finite number >= 0");
-  }
+  const std::vector<double> times = ParseFrames(o.Frames, o.FramesOption);
+  CheckSize(o.FeatureSize);
   if (!std::isfinite(o.MaxStep) || o.MaxStep < 0)
   {
     throw std::invalid_argument("--max-step must be a finite number >= 0");
   }
-  if (o.Threads < 0)
-  {
-    throw std::invalid_argument("--threads must be at least 0");
-  }
-  if (!EndsWith(o.Model, ".icm"))
+  CheckThreads(o.Threads);
+  if (!HasExtension(o.Model, ".icm"))
   {
     throw std::invalid_argument("'" + o.Model + "' is not a .icm model");
   }
@@ -462,13 +283,17 @@ int RunModel(const RunModelOptions& o)
   Outputs out(o.Output, o.Trace);
   const auto started = Clock::now();
 
-  ProgressBar bar(!o.Json);
+  ProgressBar bar("run", false, !o.Json);
   std::size_t frame = 0;
+  auto frameOf = [&]
+  {
+    return "frame " + std::to_string(frame + 1) + "/" + std::to_string(times.size());
+  };
   engine::RunOptions runOptions;
   runOptions.progress = [&](double fraction)
   {
-    bar.show((double(frame) + 0.5 * fraction) / double(times.size()), frame + 1, times.size());
-    return !Interrupted;
+    bar.Show((double(frame) + 0.5 * fraction) / double(times.size()), frameOf());
+    return !Interrupted();
   };
   engine::CoherenceOptions meshOptions;
   meshOptions.featureSize = o.FeatureSize;
@@ -476,9 +301,8 @@ int RunModel(const RunModelOptions& o)
   meshOptions.threads = o.Threads;
   meshOptions.progress = [&](double fraction)
   {
-    bar.show(
-      (double(frame) + 0.5 + 0.5 * fraction) / double(times.size()), frame + 1, times.size());
-    return !Interrupted;
+    bar.Show((double(frame) + 0.5 + 0.5 * fraction) / double(times.size()), frameOf());
+    return !Interrupted();
   };
 
   InterruptScope interrupts;
@@ -530,8 +354,8 @@ int RunModel(const RunModelOptions& o)
       if (times.front() < model.time())
       {
         std::ostringstream os;
-        os << "--time: T0 = " << times.front() << " is before the model's start (" << model.time()
-           << ")";
+        os << o.FramesOption << ": T0 = " << times.front() << " is before the model's start ("
+           << model.time() << ")";
         throw std::invalid_argument(os.str());
       }
       if (!(o.FeatureSize > 0))
@@ -599,7 +423,7 @@ int RunModel(const RunModelOptions& o)
         throw AsParseError(e);
       }
     }
-    bar.end();
+    bar.End();
     pvd << "  </Collection>\n</VTKFile>\n";
     {
       std::ofstream file(out.Staging / (out.Stem + ".pvd"), std::ios::binary);
@@ -682,15 +506,71 @@ int RunModel(const RunModelOptions& o)
   }
   catch (const Cancelled&)
   {
-    bar.end();
+    bar.End();
     std::cerr << "ictk: interrupted; nothing written\n";
     return ExitInterrupted;
   }
   catch (...)
   {
-    bar.end();
+    bar.End();
     throw;
   }
+}
+
+namespace
+{
+
+class RunCommand final : public Command
+{
+public:
+  CLI::App* add(CLI::App& app) override
+  {
+    CLI::App* run = app.add_subcommand("run",
+      "Run a dynamic implicit complex (.icm) and write its discretised complex at every frame as a "
+      ".pvd time series (one .vtpc per frame)");
+    AddModel(run, o.Model, "The .icm model");
+    this->FramesOption =
+      AddFrames(run, o.Frames, "Frames T0:T1:DT, e.g. 0:10:0.1 (T1 included); required");
+    // The older spelling, from before --time meant an instant in every command.
+    this->TimeOption = run->add_option("--time", o.Frames, "The same as --frames (older spelling)");
+    this->FramesOption->excludes(this->TimeOption);
+    AddOutput(
+      run, o.Output, "The .pvd file; the frames go into a folder named after it, beside it");
+    run->add_option("--trace", o.Trace,
+      "Also write a JSON-lines trace: one object per evaluated time (frames and located "
+      "transitions) with time, instance, transition, events and state");
+    AddSize(run, o.FeatureSize,
+      "Mesh edge length and curve step, the same for every frame (default: 1/64 of the "
+      "complex's size at the model's start)");
+    run->add_option("--max-step", o.MaxStep, "The engine's largest time step (default: DT)");
+    run->add_flag("--no-coherence", o.NoCoherence,
+      "Re-mesh every cell of every frame instead of moving the meshes of unchanged cells");
+    AddThreads(run, o.Threads, "Threads for the discretisers (default: all cores)");
+    AddJson(run, o.Json, "Print the summary as JSON");
+    return run;
+  }
+
+  int run() override
+  {
+    if (this->FramesOption->count() == 0 && this->TimeOption->count() == 0)
+    {
+      throw UserError("--frames is required (see ictk --help)");
+    }
+    o.FramesOption = this->TimeOption->count() > 0 ? "--time" : "--frames";
+    return RunModel(o);
+  }
+
+private:
+  RunModelOptions o;
+  CLI::Option* FramesOption = nullptr;
+  CLI::Option* TimeOption = nullptr;
+};
+
+} // namespace
+
+std::unique_ptr<Command> runCommand()
+{
+  return std::make_unique<RunCommand>();
 }
 
 } // namespace ictk::cli

@@ -1,8 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "TetraCommand.h"
+// `ictk tetra`: a tetrahedral mesh of a complex for FEA, every tetrahedron labelled by cell and
+// material, with a quality, validity and volume report.
+#include "Command.h"
+#include "Models.h"
+#include "Options.h"
+#include "Output.h"
+#include "Progress.h"
 
 #include "Complex/Discretization.h"
-#include "ComplexCommands.h"
 #include "FRep/Sampling.h"
 #include "Mesh/Backends/Backends.h"
 #include "Mesh/Quality.h"
@@ -18,85 +23,89 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <optional>
-#include <stdexcept>
 
 namespace ictk::cli
 {
 namespace
 {
 
-bool EndsWith(std::string s, const std::string& suffix)
-{
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s.size() >= suffix.size() &&
-    s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 /// .vtu through VTK's writer, into a temporary file renamed on success.
 void WriteVtu(const mesh::TetMesh& m, const std::string& path)
 {
-  namespace fs = std::filesystem;
   vtkNew<vtkUnstructuredGrid> grid;
   ictkTetrahedralize::Convert(m, grid);
-  const fs::path target = fs::absolute(path);
-  const fs::path temporary = target.parent_path() /
-    ("." + target.filename().string() + ".ictk-" + std::to_string(::getpid()) + ".vtu");
+  AtomicOutput file(path);
   vtkNew<vtkXMLUnstructuredGridWriter> writer;
   writer->SetInputData(grid);
-  writer->SetFileName(temporary.string().c_str());
+  writer->SetFileName(file.Path().c_str());
   writer->SetDataModeToAppended();
   if (writer->Write() != 1 || writer->GetErrorCode() != 0)
   {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write '" + path + "'");
+    throw UserError("cannot write '" + path + "'");
   }
-  fs::rename(temporary, target);
+  file.Commit();
 }
 
-} // namespace
+struct TetraOptions
+{
+  std::string Model;
+  std::string Output;
+  std::string Backend;
+  double Size = 0;
+  bool Deterministic = false;
+  bool Json = false;
+  std::string MshVersion = "4.1";
+  double MaxTetrahedra = 2e7;
+  int Threads = 0;
+};
 
-CLI::App* AddTetraCommand(CLI::App& app, TetraOptions& o)
+class TetraCommand final : public Command
+{
+public:
+  CLI::App* add(CLI::App& app) override;
+  int run() override;
+
+private:
+  TetraOptions o;
+};
+
+CLI::App* TetraCommand::add(CLI::App& app)
 {
   CLI::App* tetra = app.add_subcommand("tetra",
     "Tetrahedral mesh of a complex for FEA (.vtu, .msh, .inp, .mesh), every tetrahedron labelled "
     "by cell and material, with a quality report");
-  tetra->add_option("model", o.Model, "A .json complex or a .hf / .xml model")->required();
-  tetra->add_option("-o,--output", o.Output, "Output: .vtu, .msh (Gmsh 4.1), .inp, .mesh")
-    ->required();
+  AddModel(tetra, o.Model, "A .json complex or a .hf / .xml model");
+  AddOutput(tetra, o.Output, "Output: .vtu, .msh (Gmsh 4.1), .inp, .mesh");
   tetra->add_option("--backend", o.Backend, "cgal or tetgen (default: cgal when built)");
-  tetra->add_option(
-    "--size,--feature-size", o.Size, "Target edge length (default: 1/32 of the complex's size)");
+  AddSize(tetra, o.Size, "Target edge length (default: 1/32 of the complex's size)");
   tetra->add_flag("--deterministic", o.Deterministic, "Identical output run to run");
   tetra->add_option("--max-tets", o.MaxTetrahedra, "Refuse meshes estimated above this");
-  tetra->add_option("--threads", o.Threads, "Threads (default: all cores)");
-  tetra->add_flag("--json", o.Json, "Print the report as JSON");
+  AddThreads(tetra, o.Threads);
+  AddJson(tetra, o.Json, "Print the report as JSON");
   tetra->add_option("--msh-version", o.MshVersion, "Gmsh file format: 4.1 (default) or 2.2")
     ->check(CLI::IsMember({ "4.1", "2.2" }));
   return tetra;
 }
 
-int RunTetra(const TetraOptions& o)
+int TetraCommand::run()
 {
-  if (!(EndsWith(o.Output, ".vtu") || EndsWith(o.Output, ".msh") || EndsWith(o.Output, ".inp") ||
-        EndsWith(o.Output, ".mesh")))
+  if (!(HasExtension(o.Output, ".vtu") || HasExtension(o.Output, ".msh") ||
+        HasExtension(o.Output, ".inp") || HasExtension(o.Output, ".mesh")))
   {
-    throw std::invalid_argument("-o: '" + o.Output + "' is not a .vtu, .msh, .inp or .mesh file");
+    throw UserError("-o: '" + o.Output + "' is not a .vtu, .msh, .inp or .mesh file");
   }
+  CheckSize(o.Size);
+  CheckThreads(o.Threads);
   const std::optional<mesh::Backend> chosen =
     o.Backend.empty() ? mesh::defaultBackend() : mesh::backendFromName(o.Backend);
   if (!chosen)
   {
-    throw std::invalid_argument(o.Backend.empty()
+    throw UserError(o.Backend.empty()
         ? std::string(
             "no tetrahedral backend was built (configure with ICTK_ENABLE_GPL_BACKENDS=ON)")
         : "--backend must be cgal or tetgen, not '" + o.Backend + "'");
@@ -104,7 +113,7 @@ int RunTetra(const TetraOptions& o)
   const std::string backend = mesh::backendName(*chosen);
   if (!mesh::hasBackend(*chosen))
   {
-    throw std::invalid_argument("the " + backend +
+    throw UserError("the " + backend +
       " backend was not built (configure with ICTK_ENABLE_GPL_BACKENDS=ON and its library)");
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -120,32 +129,33 @@ int RunTetra(const TetraOptions& o)
   options.deterministic = o.Deterministic;
   options.maxTetrahedra = o.MaxTetrahedra;
   options.threads = o.Threads;
-  const bool terminal = ::isatty(2) && !o.Json;
-  int lastPercent = -1;
+  ProgressBar bar("tetra", false, !o.Json);
   options.progress = [&](double fraction)
   {
-    const int percent = static_cast<int>(100 * fraction);
-    if (terminal && percent != lastPercent)
-    {
-      std::fprintf(stderr, "\rtetra: %3d%%", percent);
-      lastPercent = percent;
-    }
+    bar.Show(fraction);
     return true;
   };
   mesh::ValidityReport validity;
-  mesh::TetMesh m = mesh::tetrahedralize(k, *chosen, options, &validity);
-  if (terminal)
+  mesh::TetMesh m = [&]
   {
-    std::fprintf(stderr, "\n");
-  }
+    try
+    {
+      return mesh::tetrahedralize(k, *chosen, options, &validity);
+    }
+    catch (...)
+    {
+      bar.End();
+      throw;
+    }
+  }();
+  bar.End();
   mesh::assignAttributes(m, k);
-  const double meshSeconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (EndsWith(o.Output, ".vtu"))
+  const double meshSeconds = Seconds(t0);
+  if (HasExtension(o.Output, ".vtu"))
   {
     WriteVtu(m, o.Output);
   }
-  else if (EndsWith(o.Output, ".msh"))
+  else if (HasExtension(o.Output, ".msh"))
   {
     mesh::writeGmsh(
       m, o.Output, o.MshVersion == "2.2" ? mesh::GmshVersion::V22 : mesh::GmshVersion::V41);
@@ -193,6 +203,13 @@ int RunTetra(const TetraOptions& o)
             << mesh::formatQualityReport(q) << mesh::formatValidityReport(validity)
             << mesh::formatVolumeComparison(volumes);
   return 0;
+}
+
+} // namespace
+
+std::unique_ptr<Command> tetraCommand()
+{
+  return std::make_unique<TetraCommand>();
 }
 
 } // namespace ictk::cli

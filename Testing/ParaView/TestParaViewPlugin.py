@@ -221,7 +221,7 @@ check(materials == (1.0, 2.0), f"bar MaterialId range {materials}")
 # The dynamic complex: time steps over the model's span, the instances of the engine's own run.
 icm = os.path.join(DATA, "Models", "icm", "ch5_1_disk_rectangle.icm")
 trace = os.path.join(WORK, "disk.jsonl")
-subprocess.run([ICTK, "run", icm, "--time", "0:6:1", "-o", os.path.join(WORK, "disk.pvd"), "--trace", trace],
+subprocess.run([ICTK, "run", icm, "--frames", "0:6:1", "-o", os.path.join(WORK, "disk.pvd"), "--trace", trace],
                check=True, capture_output=True)
 engine = {}
 for line in open(trace):

@@ -63,6 +63,10 @@ def check_eval_json(ictk, work):
     outside = json.loads(run(ictk, ["eval", "sphere", "--at", "2,0,0,0.5", "--json"]).stdout)
     if outside["membership"] != 0 or outside["point"][3] != 0.5:
         sys.exit(f"FAIL: outside point: {outside}")
+    # --time is an instant in every command: x,y,z with --time t is the point x,y,z,t.
+    timed = json.loads(run(ictk, ["eval", "sphere", "--at", "2,0,0", "--time", "0.5", "--json"]).stdout)
+    if timed != outside:
+        sys.exit(f"FAIL: --time 0.5 gives {timed}, not {outside}")
     on = json.loads(run(ictk, ["eval", "sphere", "--at", "1,0,0", "--json"]).stdout)
     if on["membership"] != 1:
         sys.exit(f"FAIL: boundary point: {on}")
@@ -549,7 +553,7 @@ def check_run_disk(ictk, work, data):
     model = os.path.join(data, "Models", "icm", "ch5_1_disk_rectangle.icm")
     pvd = os.path.join(work, "disk.pvd")
     trace = os.path.join(work, "disk.jsonl")
-    args = ["run", model, "--time", "0:6:0.5", "-o", pvd, "--trace", trace, "--feature-size", "0.1"]
+    args = ["run", model, "--frames", "0:6:0.5", "-o", pvd, "--trace", trace, "--feature-size", "0.1"]
     summary = json.loads(run(ictk, args + ["--json"]).stdout)
     if summary["frames"] != 13 or summary["final_instance"] != "K3":
         sys.exit(f"FAIL: summary {summary}")
@@ -630,17 +634,17 @@ def check_run_errors(ictk, work, data):
     os.makedirs(os.path.join(work, "keep"))
     with open(os.path.join(work, "keep", "keep_0000.vtpc"), "w") as f:
         f.write("an earlier frame")
-    p = run(ictk, ["run", broken, "--time", "0:1:0.5", "-o", keep], check=False)
+    p = run(ictk, ["run", broken, "--frames", "0:1:0.5", "-o", keep], check=False)
     if p.returncode != 2 or not re.match(re.escape(broken) + r":3:\d+: error: ", p.stderr):
         sys.exit(f"FAIL: malformed model: exit {p.returncode}, stderr:\n{p.stderr}")
-    # T0 before the model's start (its TIMESPAN starts at 0).
+    # T0 before the model's start (its TIMESPAN starts at 0), given in the older spelling --time.
     p = run(ictk, ["run", model, "--time=-1:1:0.5", "-o", keep], check=False)
-    if p.returncode != 2 or "is before the model's start" not in p.stderr:
+    if p.returncode != 2 or "--time: T0 = -1 is before the model's start" not in p.stderr:
         sys.exit(f"FAIL: T0 before the start: exit {p.returncode}, stderr:\n{p.stderr}")
     # The frames folder holds something else: refused before any work.
     with open(os.path.join(work, "keep", "notes.txt"), "w") as f:
         f.write("mine")
-    p = run(ictk, ["run", model, "--time", "0:1:0.5", "-o", keep], check=False)
+    p = run(ictk, ["run", model, "--frames", "0:1:0.5", "-o", keep], check=False)
     if p.returncode != 2 or "holds other files ('notes.txt')" not in p.stderr:
         sys.exit(f"FAIL: foreign files: exit {p.returncode}, stderr:\n{p.stderr}")
     with open(keep) as f:

@@ -1,4 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
+// The recursive-descent parser of the IC model language (IcmParser.h; grammar in docs/icm.md).
+// One file of more than 1,000 lines on purpose: it is one class, Parser, whose grammar functions
+// (top-level items, sections, cells, attributes, instances, relations, reactions, statements,
+// expressions) call each other and share the token cursor, the error recovery and the nesting and
+// node budgets. Splitting it by section would put the whole class in a header and spread one
+// grammar over several files without making any part independent of the rest.
 #include "Lang/IcmParser.h"
 
 #include "Lang/IcmLexer.h"

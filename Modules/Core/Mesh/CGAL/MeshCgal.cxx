@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The CGAL Mesh_3 backend. This is the only translation unit that includes Mesh_3 (it takes about
 // a minute and 3-4 GB to compile); linking it makes the binary GPL-3.0-or-later.
+// It is one file of more than 1,000 lines on purpose: every piece split off would either include
+// Mesh_3 again (another minute and 3-4 GB per translation unit) or need its types in a header,
+// which would spread that cost to every file that includes it.
 #include "Mesh/CGAL/MeshCgal.h"
 
 #include "Complex/Discretization.h"

@@ -16,9 +16,11 @@
 //   andyhausen-100        a 10-second, 100-step run of Data/Models/icm/andyhausen.icm with the
 //                         complex discretised at every step, time-coherent (issue 5); -full: the
 //                         same run re-meshing every cell of every frame
-#include "Bench.h"
 #include "BenchDynamics.h"
 #include "BenchScaling.h"
+#include "Command.h"
+#include "Options.h"
+#include "Progress.h"
 
 #include "Complex/Discretization.h"
 #include "Discretize/Surface.h"
@@ -59,7 +61,7 @@
 #include <thread>
 #include <vector>
 
-namespace ictk::app
+namespace ictk::cli
 {
 
 namespace
@@ -102,20 +104,6 @@ struct Result
   nlohmann::json details = nlohmann::json::object();
 };
 
-double Median(std::vector<double> v)
-{
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double ProcessCpuSeconds()
-{
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 /// One untimed warm-up run, then `runs` timed ones (wall-clock seconds). `cpu`, when given,
 /// receives the process CPU seconds of each run: on a shared machine, CPU time / threads is what
 /// the run would take with the cores to itself.
@@ -126,12 +114,11 @@ std::vector<double> Time(
   std::vector<double> seconds;
   for (int i = 0; i < runs; ++i)
   {
-    const double c0 = ProcessCpuSeconds();
+    const double c0 = CpuSeconds();
     const auto t0 = std::chrono::steady_clock::now();
     f();
-    const auto t1 = std::chrono::steady_clock::now();
-    const double c1 = ProcessCpuSeconds();
-    seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+    seconds.push_back(Seconds(t0));
+    const double c1 = CpuSeconds();
     if (cpu)
     {
       cpu->push_back(c1 - c0);
@@ -522,18 +509,23 @@ bool Selected(const std::string& name)
   }
   return false;
 }
-} // namespace
+class BenchCommand final : public Command
+{
+public:
+  CLI::App* add(CLI::App& app) override;
+  int run() override;
+};
 
-CLI::App* AddBenchCommand(CLI::App& app)
+CLI::App* BenchCommand::add(CLI::App& app)
 {
   CLI::App* bench = app.add_subcommand("bench",
     "Time the performance workloads (prospero rendering, csg3 sampling against VTK, sphereGyroid "
     "meshing, the flower complex); see docs/performance.md");
-  bench->add_flag("--json", Options.Json, "Print a JSON array, one object per workload");
+  AddJson(bench, Options.Json, "Print a JSON array, one object per workload");
   bench->add_option("--models", Options.Models,
     "Folder of Fidget's .vm models (default: $ICTK_BENCH_MODELS, else the build's default)");
-  bench->add_option("--threads", Options.Threads,
-    "Threads for every workload (default: 1 for brute force, 2 otherwise)");
+  AddThreads(
+    bench, Options.Threads, "Threads for every workload (default: 1 for brute force, 2 otherwise)");
   bench->add_option("--runs", Options.Runs, "Timed runs per workload (median reported)")
     ->check(CLI::Range(1, 1000));
   bench->add_option(
@@ -544,12 +536,9 @@ CLI::App* AddBenchCommand(CLI::App& app)
   return bench;
 }
 
-int RunBenchCommand()
+int BenchCommand::run()
 {
-  if (Options.Threads < 0)
-  {
-    throw std::invalid_argument("--threads must be at least 0");
-  }
+  CheckThreads(Options.Threads);
   if (ScalingRequested())
   {
     return RunScalingBench(Options.Runs, Options.Threads, Options.Json, Options.Quick);
@@ -641,4 +630,11 @@ int RunBenchCommand()
   return 0;
 }
 
-} // namespace ictk::app
+} // namespace
+
+std::unique_ptr<Command> benchCommand()
+{
+  return std::make_unique<BenchCommand>();
+}
+
+} // namespace ictk::cli

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The FRep XML interchange format; docs/frep-xml.md describes it.
+// Reading the FRep XML interchange format (docs/frep-xml.md); FRepXmlWriter.cxx writes it.
 //
-// Writing is done by hand rather than through a pugixml DOM: the output is then deterministic to
-// the byte, and linear in the DAG size. Reading uses pugixml (whose parser is iterative, so deep
-// documents cannot overflow the stack) and walks the document with an explicit stack for the same
-// reason.
+// Reading uses pugixml (whose parser is iterative, so deep documents cannot overflow the stack)
+// and walks the document with an explicit stack for the same reason. Every error is reported with
+// its file:line:col, and reading goes on to collect the others (up to Limits).
 #include "Lang/FRepXml.h"
 
 #include <pugixml.hpp>
@@ -14,11 +13,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <optional>
 #include <stdexcept>
 #include <unordered_map>
-#include <unordered_set>
 
 namespace ictk::lang
 {
@@ -30,252 +27,10 @@ using frep::Domain;
 using frep::Expr;
 using frep::Opcode;
 
-// Writer nesting budget: a sub-expression deeper than this moves to <defs> and is referenced, so
-// that a long chain (a union of thousands of shapes) still reads back under Limits::maxNesting.
-constexpr int kMaxInlineDepth = 48;
 // Parameter slots above this are refused: the evaluators allocate one value per slot.
 constexpr std::uint32_t kMaxParameterSlot = 1u << 20;
 // Attribute component counts above this are refused (a 256 x 256 tensor is already absurd).
 constexpr std::uint64_t kMaxComponents = 1u << 16;
-
-std::string formatNumber(double v)
-{
-  // 17 significant digits: every double reads back exactly. to_chars ignores the C locale.
-  char buf[64];
-  auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 17);
-  return std::string(buf, r.ptr);
-}
-
-std::string numberList(const std::vector<double>& values)
-{
-  std::string s;
-  for (std::size_t i = 0; i < values.size(); ++i)
-  {
-    if (i)
-    {
-      s += ' ';
-    }
-    s += formatNumber(values[i]);
-  }
-  return s;
-}
-
-std::string escapeAttribute(const std::string& value, const char* what)
-{
-  std::string s;
-  s.reserve(value.size());
-  for (char c : value)
-  {
-    switch (c)
-    {
-      case '&':
-        s += "&amp;";
-        break;
-      case '<':
-        s += "&lt;";
-        break;
-      case '>':
-        s += "&gt;";
-        break;
-      case '"':
-        s += "&quot;";
-        break;
-      // Character references, because a parser normalises literal white space in attributes.
-      case '\n':
-        s += "&#10;";
-        break;
-      case '\r':
-        s += "&#13;";
-        break;
-      case '\t':
-        s += "&#9;";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20)
-        {
-          throw std::invalid_argument(std::string("writeFRepXml: the ") + what +
-            " contains a control character, which XML 1.0 cannot carry");
-        }
-        s += c;
-    }
-  }
-  return s;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Writer
-
-class XmlWriter
-{
-public:
-  std::string write(const frep::Hypervolume& hv, const std::string& name, int parameterCount,
-    const std::optional<std::array<double, 6>>& bounds)
-  {
-    std::vector<Expr> roots;
-    roots.push_back(hv.geometry().function());
-    for (const frep::Attribute& a : hv.attributes())
-    {
-      roots.push_back(a.partition);
-      roots.insert(roots.end(), a.components.begin(), a.components.end());
-    }
-    analyse(roots);
-    // The a parameter array must cover every slot the model reads.
-    parameterCount = std::max(parameterCount, static_cast<int>(maxSlot_ + 1));
-
-    out_ += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    out_ += "<frep version=\"1\" name=\"" + escapeAttribute(name, "model name") +
-      "\" parameters=\"" + std::to_string(parameterCount) + "\">\n";
-    if (bounds)
-    {
-      const auto& b = *bounds;
-      out_ += "  <bounds lo=\"" + numberList({ b[0], b[2], b[4] }) + "\" hi=\"" +
-        numberList({ b[1], b[3], b[5] }) + "\"/>\n";
-    }
-    out_ += std::string("  <geometry domain=\"") + frep::domainName(hv.geometry().domain()) +
-      "\" threshold=\"" + formatNumber(hv.threshold()) + "\">\n";
-    if (!spilledOrder_.empty())
-    {
-      out_ += "    <defs>\n";
-      for (const Expr& e : spilledOrder_)
-      {
-        writeExpr(e, 3, true);
-      }
-      out_ += "    </defs>\n";
-    }
-    writeExpr(hv.geometry().function(), 2, false);
-    out_ += "  </geometry>\n";
-    for (const frep::Attribute& a : hv.attributes())
-    {
-      out_ += "  <attribute name=\"" + escapeAttribute(a.name, "attribute name") +
-        "\" components=\"" + std::to_string(a.components.size()) + "\" tensorRows=\"" +
-        std::to_string(a.tensorRows) + "\">\n";
-      out_ += "    <partition>\n";
-      writeExpr(a.partition, 3, false);
-      out_ += "    </partition>\n";
-      for (const Expr& c : a.components)
-      {
-        out_ += "    <component>\n";
-        writeExpr(c, 3, false);
-        out_ += "    </component>\n";
-      }
-      out_ += "    <inside>" + numberList(a.insideDefault) + "</inside>\n";
-      out_ += "    <outside>" + numberList(a.outsideDefault) + "</outside>\n";
-      out_ += "  </attribute>\n";
-    }
-    out_ += "</frep>\n";
-    return std::move(out_);
-  }
-
-private:
-  // Counts the parents of every node over all roots, finds the nodes that must move to <defs>
-  // (in post-order, so that each is defined before use) and the largest parameter slot.
-  void analyse(const std::vector<Expr>& roots)
-  {
-    std::unordered_map<const frep::Node*, int> depth;
-    std::unordered_set<const frep::Node*> done;
-    for (const Expr& root : roots)
-    {
-      ++uses_[root.id()];
-      if (done.count(root.id()))
-      {
-        continue;
-      }
-      std::vector<std::pair<Expr, int>> stack;
-      stack.emplace_back(root, 0);
-      while (!stack.empty())
-      {
-        auto& [e, next] = stack.back();
-        if (next < e.arity())
-        {
-          Expr c = e.child(next++);
-          ++uses_[c.id()];
-          if (!done.count(c.id()))
-          {
-            done.insert(c.id());
-            stack.emplace_back(std::move(c), 0);
-          }
-          continue;
-        }
-        done.insert(e.id());
-        int d = 1;
-        for (int i = 0; i < e.arity(); ++i)
-        {
-          const frep::Node* c = e.child(i).id();
-          d = std::max(d, 1 + (spilled_.count(c) ? 1 : depth.at(c)));
-        }
-        if (e.opcode() == Opcode::Parameter)
-        {
-          maxSlot_ = std::max<long long>(maxSlot_, e.parameterSlot());
-        }
-        if (d > kMaxInlineDepth)
-        {
-          spilled_.insert(e.id());
-          spilledOrder_.push_back(e);
-        }
-        depth[e.id()] = d;
-        stack.pop_back();
-      }
-    }
-  }
-
-  void indent(int level) { out_.append(static_cast<std::size_t>(level) * 2, ' '); }
-
-  // Recursion is bounded by kMaxInlineDepth thanks to the spilling above.
-  void writeExpr(const Expr& e, int level, bool define)
-  {
-    indent(level);
-    switch (e.opcode())
-    {
-      case Opcode::Constant:
-        out_ += "<const value=\"" + formatNumber(e.constantValue()) + "\"/>\n";
-        return;
-      case Opcode::Variable:
-        out_ += std::string("<var axis=\"") + frep::axisName(e.axis()) + "\"/>\n";
-        return;
-      case Opcode::Parameter:
-        out_ += "<param slot=\"" + std::to_string(e.parameterSlot()) + "\"/>\n";
-        return;
-      default:
-        break;
-    }
-    // A spilled node is defined in <defs> (in post-order) before anything refers to it, so it
-    // is always found here when not being defined.
-    auto written = ids_.find(e.id());
-    if (written != ids_.end())
-    {
-      out_ += "<ref id=\"" + written->second + "\"/>\n";
-      return;
-    }
-    out_ += '<';
-    out_ += frep::opcodeName(e.opcode());
-    if (define || uses_.at(e.id()) > 1)
-    {
-      std::string id = "n" + std::to_string(nextId_++);
-      out_ += " id=\"" + id + "\"";
-      ids_.emplace(e.id(), std::move(id));
-    }
-    out_ += ">\n";
-    for (int i = 0; i < e.arity(); ++i)
-    {
-      writeExpr(e.child(i), level + 1, false);
-    }
-    indent(level);
-    out_ += "</";
-    out_ += frep::opcodeName(e.opcode());
-    out_ += ">\n";
-  }
-
-  std::string out_;
-  std::unordered_map<const frep::Node*, int> uses_;
-  std::unordered_set<const frep::Node*> spilled_;
-  std::vector<Expr> spilledOrder_;
-  std::unordered_map<const frep::Node*, std::string> ids_;
-  int nextId_ = 1;
-  long long maxSlot_ = -1;
-};
-
-// ---------------------------------------------------------------------------------------------
-// Reader
 
 // Thrown internally to stop reading once the diagnostics are complete (or too many).
 struct StopReading
@@ -1186,12 +941,6 @@ FRepXmlDocument readFRepXmlDocument(
   return result;
 }
 
-std::string writeFRepXmlDocument(const frep::Hypervolume& model, const std::string& name,
-  int parameterCount, const std::optional<std::array<double, 6>>& bounds)
-{
-  return XmlWriter().write(model, name, parameterCount, bounds);
-}
-
 frep::Hypervolume readFRepXml(
   const std::string& text, const std::string& fileName, const Limits& limits)
 {
@@ -1201,11 +950,6 @@ frep::Hypervolume readFRepXml(
 frep::Hypervolume readFRepXmlFile(const std::string& path, const Limits& limits)
 {
   return readFRepXml(readSourceFile(path, limits), path, limits);
-}
-
-std::string writeFRepXml(const frep::Hypervolume& model, const std::string& name)
-{
-  return writeFRepXmlDocument(model, name, 0, std::nullopt);
 }
 
 } // namespace ictk::lang

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// `ictk convert`: a model translated between HyperFun (.hf) and FRep XML (.xml); a registered
+// model can be exported too.
+#include "Command.h"
+#include "Models.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+namespace ictk::cli
+{
+namespace
+{
+
+class ConvertCommand final : public Command
+{
+public:
+  CLI::App* add(CLI::App& app) override
+  {
+    CLI::App* convert =
+      app.add_subcommand("convert", "Translate a model between HyperFun (.hf) and FRep XML (.xml)");
+    convert->add_option("input", this->Input, "A .hf or .xml file, or a registered model")
+      ->required();
+    convert->add_option("output", this->Output, "The .hf or .xml file to write")->required();
+    return convert;
+  }
+
+  int run() override
+  {
+    if (!lang::isModelFile(this->Output))
+    {
+      throw UserError("convert: '" + this->Output + "' is not a .hf or .xml file");
+    }
+    auto open = [&]() -> lang::ModelFile
+    {
+      if (lang::isModelFile(this->Input))
+      {
+        return OpenModelFile(this->Input);
+      }
+      const frep::ModelInfo& info = FindModel(this->Input);
+      return { info.name, 0, info.build(),
+        std::array<double, 6>{ info.boundsLo[0], info.boundsHi[0], info.boundsLo[1],
+          info.boundsHi[1], info.boundsLo[2], info.boundsHi[2] } };
+    };
+    const lang::ModelFile model = open();
+    try
+    {
+      lang::saveModelFile(model, this->Output);
+    }
+    catch (const std::exception& e)
+    {
+      throw UserError(e.what());
+    }
+    std::cout << "wrote " << this->Output << " (model '" << model.name << "')\n";
+    return 0;
+  }
+
+private:
+  std::string Input;
+  std::string Output;
+};
+
+} // namespace
+
+std::unique_ptr<Command> convertCommand()
+{
+  return std::make_unique<ConvertCommand>();
+}
+
+} // namespace ictk::cli

@@ -1,0 +1,326 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "GridSampling.h"
+
+#include "Command.h"
+#include "Options.h"
+#include "Output.h"
+#include "Progress.h"
+#include "VtkMessages.h"
+
+#include "FRep/Evaluators.h"
+#include "ictkFRepSampler.h"
+
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
+#include <vtkDataObject.h>
+#include <vtkFloatArray.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkOBJWriter.h>
+#include <vtkPLYWriter.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkSMPTools.h>
+#include <vtkSTLWriter.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <sstream>
+
+namespace ictk::cli
+{
+namespace
+{
+
+// Evaluates the hypervolume's attributes at every vertex of a boundary surface, taken from the
+// inside of the solid: each vertex (on f = 0 only up to Flying Edges' linear interpolation) is
+// moved by a few Newton steps along the gradient to where f is just positive, about `inset` inside.
+// Arrays are named as the attributes, with their component counts.
+void AttachBoundaryAttributes(vtkPolyData* surface, const frep::Hypervolume& hv,
+  const std::vector<double>& params, double time, double inset)
+{
+  if (hv.attributes().empty() || surface->GetNumberOfPoints() == 0)
+  {
+    return;
+  }
+  frep::HypervolumeEvaluator evaluator(hv, params);
+  frep::GradientEvaluator gradient(frep::Tape::compile(hv.geometry().function()), params);
+  std::vector<vtkSmartPointer<vtkFloatArray>> arrays;
+  for (const frep::Attribute& a : hv.attributes())
+  {
+    auto array = vtkSmartPointer<vtkFloatArray>::New();
+    array->SetName(a.name.c_str());
+    array->SetNumberOfComponents(static_cast<int>(a.components.size()));
+    array->SetNumberOfTuples(surface->GetNumberOfPoints());
+    arrays.push_back(array);
+  }
+  std::vector<double> values(hv.attributeComponentCount());
+  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
+  {
+    double p[3];
+    surface->GetPoint(i, p);
+    for (int iteration = 0; iteration < 4; ++iteration)
+    {
+      const frep::ValueGradient g = gradient.eval(p[0], p[1], p[2], time);
+      const double g2 = g.gradient[0] * g.gradient[0] + g.gradient[1] * g.gradient[1] +
+        g.gradient[2] * g.gradient[2];
+      const double target = hv.threshold() + inset * std::sqrt(g2);
+      if (!(g2 > 0) || !std::isfinite(g.value) || g.value >= target)
+      {
+        break;
+      }
+      for (int k = 0; k < 3; ++k)
+      {
+        p[k] += (target - g.value) * g.gradient[k] / g2;
+      }
+    }
+    double f;
+    evaluator.eval({ p[0], p[1], p[2], time }, f, values.data());
+    std::size_t k = 0;
+    for (auto& array : arrays)
+    {
+      for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+      {
+        array->SetTypedComponent(i, c, static_cast<float>(values[k++]));
+      }
+    }
+  }
+  for (auto& array : arrays)
+  {
+    surface->GetPointData()->AddArray(array);
+  }
+}
+
+void OnProgress(vtkObject* caller, unsigned long, void* clientData, void* callData)
+{
+  static_cast<ProgressBar*>(clientData)->Show(*static_cast<double*>(callData));
+  if (Interrupted())
+  {
+    static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1);
+  }
+}
+
+} // namespace
+
+void GridCommandOptions::AddTo(CLI::App* command, std::int64_t defaultResolution)
+{
+  this->Resolution = defaultResolution;
+  AddModel(command, this->Model, "Model name (see `ictk models`) or a .hf / .xml file");
+  CLI::Option* resolution = command->add_option("--resolution", this->Resolution,
+    "Points per axis (default " + std::to_string(defaultResolution) + ")");
+  CLI::Option* dims = command->add_option("--dims", this->Dims, "Points per axis: NX,NY,NZ");
+  resolution->excludes(dims);
+  command->add_option(
+    "--bounds", this->Bounds, "Sampled box x0,x1,y0,y1,z0,z1 (default: the model's bounds)");
+  AddTime(command, this->Time);
+  AddThreads(command, this->Threads);
+  AddParams(command, this->Params);
+}
+
+GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
+{
+  const std::vector<double> params = ParseParameters(o.Params);
+  GridPlan plan{ ResolveModel(o.Model, params), params, {}, {} };
+  if (!std::isfinite(o.Time))
+  {
+    throw UserError("--time must be a finite number");
+  }
+  CheckThreads(o.Threads);
+  std::array<double, 3>& lo = plan.Model.Lo;
+  std::array<double, 3>& hi = plan.Model.Hi;
+  if (!o.Bounds.empty())
+  {
+    const std::vector<double> b = ParseNumbers(
+      o.Bounds, "--bounds", { "x0", "x1", "y0", "y1", "z0", "z1" }, 6, 6, "x0,x1,y0,y1,z0,z1");
+    static const char* axes[] = { "x", "y", "z" };
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = b[2 * a];
+      hi[a] = b[2 * a + 1];
+      if (lo[a] > hi[a])
+      {
+        std::ostringstream os;
+        os << "--bounds: " << axes[a] << "0 > " << axes[a] << "1 (" << lo[a] << " > " << hi[a]
+           << ")";
+        throw UserError(os.str());
+      }
+    }
+  }
+  std::array<std::int64_t, 3>& dims = plan.Dims;
+  if (!o.Dims.empty())
+  {
+    dims = ParseDims(o.Dims);
+    static const char* names[] = { "NX", "NY", "NZ" };
+    for (int a = 0; a < 3; ++a)
+    {
+      if (dims[a] < 1)
+      {
+        throw UserError(std::string("--dims: ") + names[a] + " must be at least 1, got " +
+          std::to_string(dims[a]));
+      }
+    }
+  }
+  else
+  {
+    if (o.Resolution < 2)
+    {
+      throw UserError("--resolution must be at least 2, got " + std::to_string(o.Resolution));
+    }
+    dims = { o.Resolution, o.Resolution, o.Resolution };
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    // A flat axis of the box (a 2D model) is sampled once, as ictkFRepSampler does.
+    if (!(hi[a] > lo[a]))
+    {
+      dims[a] = 1;
+    }
+  }
+  plan.Grid = frep::gridOverBox(lo, hi, dims, o.Time);
+  try
+  {
+    frep::checkGrid(plan.Grid, (1 + plan.Model.Model.attributeComponentCount()) * bytesPerValue);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(std::string("cannot sample: ") + e.what());
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    // VTK extents are int.
+    if (dims[a] > INT_MAX)
+    {
+      throw UserError("cannot sample: " + std::to_string(dims[a]) +
+        " points along one axis is more than VTK's limit of " + std::to_string(INT_MAX));
+    }
+  }
+  if (o.Threads > 0)
+  {
+    vtkSMPTools::Initialize(o.Threads);
+  }
+  return plan;
+}
+
+vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, bool asDouble,
+  bool attributes, ictkCaptureOutputWindow* messages)
+{
+  vtkNew<ictkFRepSampler> sampler;
+  sampler->SetHypervolume(plan.Model.Model);
+  sampler->SetParameters(plan.Params);
+  const auto& lo = plan.Model.Lo;
+  const auto& hi = plan.Model.Hi;
+  sampler->SetModelBounds(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+  sampler->SetSampleDimensions(
+    static_cast<int>(plan.Dims[0]), static_cast<int>(plan.Dims[1]), static_cast<int>(plan.Dims[2]));
+  sampler->SetTime(plan.Grid.time);
+  sampler->SetNumberOfThreads(threads);
+  sampler->SetOutputScalarType(asDouble ? VTK_DOUBLE : VTK_FLOAT);
+  sampler->SetComputeAttributes(attributes);
+
+  ProgressBar progress("sampling " + plan.Model.Name, true);
+  vtkNew<vtkCallbackCommand> onProgress;
+  onProgress->SetCallback(OnProgress);
+  onProgress->SetClientData(&progress);
+  sampler->AddObserver(vtkCommand::ProgressEvent, onProgress);
+
+  const std::size_t errorsBefore = messages->Errors.size();
+  sampler->Update();
+  progress.End();
+  if (Interrupted())
+  {
+    return nullptr;
+  }
+  ThrowIfVtkFailed(messages, errorsBefore, "sampling failed");
+  vtkSmartPointer<vtkImageData> image = sampler->GetOutput();
+  if (image->GetNumberOfPoints() != plan.Grid.pointCount())
+  {
+    throw UserError("sampling failed: the output has " +
+      std::to_string(image->GetNumberOfPoints()) + " points instead of " +
+      std::to_string(plan.Grid.pointCount()));
+  }
+  return image;
+}
+
+vtkSmartPointer<vtkPolyData> ExtractSurface(
+  vtkImageData* image, const GridPlan& plan, ictkCaptureOutputWindow* messages)
+{
+  vtkNew<vtkFlyingEdges3D> contour;
+  contour->SetInputData(image);
+  contour->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "f");
+  contour->SetValue(0, 0.0);
+  // f grows inwards, so the negated gradient Flying Edges uses for normals points outwards.
+  contour->ComputeNormalsOn();
+  contour->ComputeScalarsOff();
+  contour->InterpolateAttributesOff();
+  const std::size_t errorsBefore = messages->Errors.size();
+  contour->Update();
+  ThrowIfVtkFailed(messages, errorsBefore, "surface extraction failed");
+  vtkSmartPointer<vtkPolyData> surface = contour->GetOutput();
+  // Interpolating the grid's attribute arrays would mix the values on both sides of the
+  // boundary (an attribute usually jumps there); evaluate them instead just inside the solid,
+  // a thousandth of a grid step from each vertex against its outward normal.
+  const auto& spacing = plan.Grid.spacing;
+  const double step = std::min({ spacing[0], spacing[1], spacing[2] });
+  AttachBoundaryAttributes(surface, plan.Model.Model, plan.Params, plan.Grid.time, 1e-3 * step);
+  return surface;
+}
+
+const char* const SurfaceFormats = ".vtp, .stl, .ply or .obj";
+
+bool IsSurfaceFormat(const std::string& path)
+{
+  return HasExtension(path, ".vtp") || HasExtension(path, ".stl") || HasExtension(path, ".ply") ||
+    HasExtension(path, ".obj");
+}
+
+void WriteSurface(vtkPolyData* surface, AtomicOutput& file, const std::string& path,
+  ictkCaptureOutputWindow* messages)
+{
+  // Every writer is given the temporary path, and reports failure through Write() and its error
+  // code (vtkXMLWriter is not a vtkWriter, so each kind is driven on its own).
+  auto run = [&](auto* writer)
+  {
+    writer->SetInputData(surface);
+    writer->SetFileName(file.Path().c_str());
+    return writer->Write() == 1 && writer->GetErrorCode() == 0;
+  };
+  const std::size_t errorsBefore = messages->Errors.size();
+  bool written = false;
+  if (HasExtension(path, ".vtp"))
+  {
+    vtkNew<vtkXMLPolyDataWriter> xml;
+    xml->SetDataModeToAppended();
+    xml->EncodeAppendedDataOff();
+    written = run(xml.Get());
+  }
+  else if (HasExtension(path, ".stl"))
+  {
+    vtkNew<vtkSTLWriter> stl;
+    stl->SetFileTypeToBinary();
+    written = run(stl.Get());
+  }
+  else if (HasExtension(path, ".ply"))
+  {
+    vtkNew<vtkPLYWriter> ply;
+    ply->SetFileTypeToBinary();
+    written = run(ply.Get());
+  }
+  else
+  {
+    vtkNew<vtkOBJWriter> obj;
+    written = run(obj.Get());
+  }
+  ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + path + "'");
+  if (!written)
+  {
+    throw UserError("cannot write '" + path + "'");
+  }
+  file.Commit();
+}
+
+} // namespace ictk::cli

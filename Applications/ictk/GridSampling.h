@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// What `ictk sample` and `ictk mesh` (for a model) share: their grid options, the grid planned and
+// checked before anything is allocated or written, the sampling with a progress bar and Ctrl-C,
+// and the surface f = 0 (Flying Edges, attributes evaluated just inside the solid) with its
+// writers (.vtp, .stl, .ply, .obj).
+
+#include "FRep/Sampling.h"
+#include "Models.h"
+
+#include <vtkSmartPointer.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace CLI
+{
+class App;
+}
+class vtkImageData;
+class vtkPolyData;
+
+namespace ictk::cli
+{
+
+class AtomicOutput;
+class ictkCaptureOutputWindow;
+
+/// The options of the commands that sample a model on a grid.
+struct GridCommandOptions
+{
+  std::string Model;
+  std::string Output;
+  std::int64_t Resolution = 64;
+  std::string Dims;
+  std::string Bounds;
+  double Time = 0;
+  int Threads = 0;
+  std::string Params;
+
+  /// Adds the model argument and the grid options (not -o, whose help differs per command).
+  void AddTo(CLI::App* command, std::int64_t defaultResolution);
+};
+
+/// The grid a command samples, checked before anything is allocated or written.
+struct GridPlan
+{
+  ResolvedModel Model;
+  std::vector<double> Params;
+  std::array<std::int64_t, 3> Dims;
+  frep::Grid Grid;
+};
+
+/// Resolves the model and checks the grid (bounds, dimensions, the memory it needs at
+/// `bytesPerValue` per value of f and of every attribute component).
+GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue);
+
+/// Samples the planned grid with a progress display; null when interrupted (Ctrl-C, inside the
+/// caller's InterruptScope).
+vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, bool asDouble,
+  bool attributes, ictkCaptureOutputWindow* messages);
+
+/// The surface f = 0 of a sampled image, with outward normals and the model's attributes
+/// evaluated at its vertices.
+vtkSmartPointer<vtkPolyData> ExtractSurface(
+  vtkImageData* image, const GridPlan& plan, ictkCaptureOutputWindow* messages);
+
+/// The surface formats, for messages.
+extern const char* const SurfaceFormats;
+bool IsSurfaceFormat(const std::string& path);
+/// Writes a surface in the format its path names (checked by IsSurfaceFormat) and commits `file`.
+void WriteSurface(vtkPolyData* surface, AtomicOutput& file, const std::string& path,
+  ictkCaptureOutputWindow* messages);
+
+} // namespace ictk::cli

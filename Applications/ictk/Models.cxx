@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Models.h"
+
+#include "Command.h"
+#include "Options.h"
+
+#include "FRep/Bounds.h"
+#include "FRep/Sampling.h"
+#include "Lang/ComplexFile.h"
+#include "Lang/Diagnostics.h"
+#include "ictkComplexSource.h"
+
+#include <stdexcept>
+
+namespace ictk::cli
+{
+
+const frep::ModelInfo& FindModel(const std::string& name)
+{
+  try
+  {
+    return frep::findModel(name);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(e.what());
+  }
+}
+
+lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>& params)
+{
+  try
+  {
+    return lang::loadModelFile(path, {}, params);
+  }
+  catch (const lang::ParseError& e)
+  {
+    // Every diagnostic, each "file:line:col: error: ..." with its source line and caret.
+    std::string text = e.what();
+    while (!text.empty() && text.back() == '\n')
+    {
+      text.pop_back();
+    }
+    throw ModelFileError(text);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(e.what());
+  }
+}
+
+ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<double>& params)
+{
+  if (!lang::isModelFile(nameOrPath))
+  {
+    const frep::ModelInfo& info = FindModel(nameOrPath);
+    return { info.name, info.build(), info.boundsLo, info.boundsHi };
+  }
+  lang::ModelFile file = OpenModelFile(nameOrPath, params);
+  const std::array<double, 6> b = lang::modelFileBounds(file, params);
+  return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] } };
+}
+
+bool IsComplexInput(const std::string& path)
+{
+  return lang::isComplexFile(path);
+}
+
+bool IsComplexOutput(const std::string& path)
+{
+  return HasExtension(path, ".vtpc") || HasExtension(path, ".vtm");
+}
+
+complex::Complex LoadComplex(const std::string& path)
+{
+  if (IsComplexInput(path))
+  {
+    return ictkComplexSource::ReadComplexFile(path);
+  }
+  if (!lang::isModelFile(path))
+  {
+    throw UserError("'" + path + "' is not a .json complex or a .hf / .xml model");
+  }
+  const lang::ModelFile model = OpenModelFile(path);
+  frep::Box3 box;
+  if (model.bounds)
+  {
+    const auto& b = *model.bounds;
+    box = { { b[0], b[2], b[4] }, { b[1], b[3], b[5] } };
+  }
+  else
+  {
+    const double h = 100; // the search box for models that do not state their bounds
+    const auto found = frep::boundingBox(
+      frep::Tape::compile(model.model.geometry().function()), { { -h, -h, -h }, { h, h, h } });
+    if (!found)
+    {
+      throw UserError("'" + path + "' is empty in [-100, 100]^3");
+    }
+    box = { found->lo, found->hi };
+  }
+  complex::Complex k;
+  k.name = model.name;
+  k.addCell(complex::frepCell(model.name, {}, { model.model.geometry().function() }, box));
+  return k;
+}
+
+} // namespace ictk::cli

@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// What the commands' `model` argument names, resolved in one place: a registered model (`ictk
+// models`), a model file (.hf, .xml) or a complex (.json). Failures are UserErrors; a model file's
+// diagnostics are a ModelFileError (printed as they are: file:line:col, source line, caret).
+
+#include "Complex/Complex.h"
+#include "FRep/Hypervolume.h"
+#include "FRep/ModelRegistry.h"
+#include "Lang/ModelFile.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace ictk::cli
+{
+
+/// A registered model, by name.
+const frep::ModelInfo& FindModel(const std::string& name);
+
+/// Opens a model file (.hf, .xml), specialised to `params` (a HyperFun file's library may need
+/// them where it wants numbers).
+lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>& params = {});
+
+/// A model ready to sample: its hypervolume and a box that holds it.
+struct ResolvedModel
+{
+  std::string Name;
+  frep::Hypervolume Model;
+  std::array<double, 3> Lo;
+  std::array<double, 3> Hi;
+};
+
+/// A registered model's name or a model file (.hf, .xml).
+ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<double>& params);
+
+/// True for a complex (.json) input.
+bool IsComplexInput(const std::string& path);
+/// True for a complex output format (.vtpc, .vtm).
+bool IsComplexOutput(const std::string& path);
+/// A .json complex (with VTK's readers for its cells' files), or a .hf / .xml model as a complex
+/// of one 3D cell.
+complex::Complex LoadComplex(const std::string& path);
+
+} // namespace ictk::cli

@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// How `ictk` writes its outputs: into a temporary file or folder beside the destination, moved
+// into place once complete, so that an error or Ctrl-C never leaves a half-written file and never
+// touches what was there before.
+
+#include <string>
+
+class vtkDataObject;
+class vtkXMLWriterBase;
+
+namespace ictk::cli
+{
+
+/// A temporary file next to the destination, renamed onto it by Commit() and removed otherwise.
+/// The constructor checks the destination (not a folder, its folder exists) and creates the
+/// temporary file, so a command can fail before spending time on the work.
+class AtomicOutput
+{
+public:
+  explicit AtomicOutput(const std::string& destination);
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+  ~AtomicOutput();
+
+  /// The temporary file to write (it keeps the destination's extension).
+  const std::string& Path() const { return this->Temporary; }
+  void Commit();
+
+private:
+  std::string Destination;
+  std::string Temporary;
+};
+
+/// Writes a composite dataset file and its folder of pieces (named after the file's stem) into a
+/// temporary folder beside `output`, then moves both into place. An earlier pieces folder is
+/// replaced only when it holds nothing but pieces of this file.
+void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::string& output);
+
+} // namespace ictk::cli

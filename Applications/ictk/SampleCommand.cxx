@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// `ictk sample`: a model sampled on a regular grid into a .vti (f and the attributes), optionally
+// with its surface f = 0.
+#include "Command.h"
+#include "GridSampling.h"
+#include "Options.h"
+#include "Output.h"
+#include "Progress.h"
+#include "VtkMessages.h"
+
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkXMLImageDataWriter.h>
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+namespace ictk::cli
+{
+namespace
+{
+
+struct SampleCommandOptions : GridCommandOptions
+{
+  bool Double = false;
+  std::string Surface;
+};
+
+class SampleCommand final : public Command
+{
+public:
+  CLI::App* add(CLI::App& app) override
+  {
+    CLI::App* sample = app.add_subcommand("sample", "Sample a model on a regular grid (.vti)");
+    o.AddTo(sample, 64);
+    AddOutput(sample, o.Output, "Output image (.vti)");
+    sample->add_flag("--double", o.Double, "Write double-precision arrays (default float)");
+    sample->add_option("--surface", o.Surface,
+      "Also extract the surface f = 0 (Flying Edges) into this .vtp, .stl, .ply or .obj");
+    return sample;
+  }
+
+  int run() override
+  {
+    if (!o.Surface.empty() && !IsSurfaceFormat(o.Surface))
+    {
+      throw UserError("--surface: '" + o.Surface + "' is not a " + SurfaceFormats + " file");
+    }
+    const GridPlan plan = PlanGrid(o, o.Double ? sizeof(double) : sizeof(float));
+    // Fail on an unwritable destination before spending time on sampling.
+    InterruptScope interrupts;
+    AtomicOutput volumeFile(o.Output);
+    std::unique_ptr<AtomicOutput> surfaceFile;
+    if (!o.Surface.empty())
+    {
+      surfaceFile = std::make_unique<AtomicOutput>(o.Surface);
+    }
+    ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+
+    const auto t0 = std::chrono::steady_clock::now();
+    vtkSmartPointer<vtkImageData> image = SampleImage(plan, o.Threads, o.Double, true, messages);
+    if (!image)
+    {
+      std::cerr << "ictk: interrupted; nothing written\n";
+      return ExitInterrupted;
+    }
+    const double sampleSeconds = Seconds(t0);
+
+    const auto t1 = std::chrono::steady_clock::now();
+    vtkNew<vtkXMLImageDataWriter> writer;
+    writer->SetInputData(image);
+    writer->SetFileName(volumeFile.Path().c_str());
+    writer->SetDataModeToAppended();
+    writer->EncodeAppendedDataOff();
+    std::size_t errorsBefore = messages->Errors.size();
+    if (writer->Write() != 1 || writer->GetErrorCode() != 0)
+    {
+      ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
+      throw UserError("cannot write '" + o.Output + "'");
+    }
+    ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
+    volumeFile.Commit();
+    const double writeSeconds = Seconds(t1);
+
+    std::cout << "wrote " << o.Output << " (" << plan.Dims[0] << " x " << plan.Dims[1] << " x "
+              << plan.Dims[2] << " points; arrays:";
+    vtkPointData* pd = image->GetPointData();
+    for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+    {
+      std::cout << (i ? ", " : " ") << pd->GetArrayName(i);
+    }
+    std::cout << ") in " << std::fixed << std::setprecision(3) << sampleSeconds + writeSeconds
+              << " s (sampling " << sampleSeconds << " s, writing " << writeSeconds << " s)\n";
+
+    if (surfaceFile)
+    {
+      const auto t2 = std::chrono::steady_clock::now();
+      vtkSmartPointer<vtkPolyData> surface = ExtractSurface(image, plan, messages);
+      WriteSurface(surface, *surfaceFile, o.Surface, messages);
+      std::cout << "wrote " << o.Surface << " (" << surface->GetNumberOfPoints() << " points, "
+                << surface->GetNumberOfPolys() << " triangles) in " << Seconds(t2) << " s\n";
+    }
+    return 0;
+  }
+
+private:
+  SampleCommandOptions o;
+};
+
+} // namespace
+
+std::unique_ptr<Command> sampleCommand()
+{
+  return std::make_unique<SampleCommand>();
+}
+
+} // namespace ictk::cli

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// VTK's error and warning texts collected instead of printed, so that a failure inside a VTK
+// filter or writer becomes one "ictk: error:" line rather than VTK's multi-line reports (and the
+// executive's follow-ups).
+
+#include <vtkOutputWindow.h>
+
+#include <string>
+#include <vector>
+
+namespace ictk::cli
+{
+
+class ictkCaptureOutputWindow : public vtkOutputWindow
+{
+public:
+  static ictkCaptureOutputWindow* New();
+  vtkTypeMacro(ictkCaptureOutputWindow, vtkOutputWindow);
+
+  void DisplayErrorText(const char* text) override;
+  void DisplayWarningText(const char* text) override;
+  void DisplayGenericWarningText(const char* text) override;
+  void DisplayText(const char*) override {}
+
+  /// The messages alone ("ERROR: In file, line N\nClass (0x...): message" -> "message").
+  std::vector<std::string> Errors;
+  std::vector<std::string> Warnings;
+};
+
+/// Installs the capturing window (once) as VTK's output window and returns it.
+ictkCaptureOutputWindow* CaptureVtkMessages();
+
+/// Throws a UserError "<what>: <message>" for the first VTK error recorded after the first
+/// `before` ones (take `before` from Errors.size() ahead of the work).
+void ThrowIfVtkFailed(
+  const ictkCaptureOutputWindow* window, std::size_t before, const std::string& what);
+
+} // namespace ictk::cli
