@@ -19,6 +19,16 @@ namespace ictk::engine
 std::vector<lang::icm::BuiltinId> interpreterBuiltins();
 /// The built-ins the running model computes (the library calls of DynamicModel), in its order.
 std::vector<lang::icm::BuiltinId> libraryBuiltins();
+/// The ids of an implementation table (pairs of BuiltinId and function), in its order.
+template <class Table>
+std::vector<lang::icm::BuiltinId> idsOf(const Table& table)
+{
+  std::vector<lang::icm::BuiltinId> ids;
+  for (const auto& entry : table)
+    ids.push_back(entry.first);
+  return ids;
+}
+
 /// One line per disagreement: an entry with no implementation, an implementation of an id with
 /// no entry or of an entry of the other layer, or two implementations of one entry. Empty when
 /// the engine implements exactly the table.

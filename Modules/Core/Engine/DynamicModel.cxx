@@ -1677,10 +1677,7 @@ const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
 
 std::vector<lang::icm::BuiltinId> libraryBuiltins()
 {
-  std::vector<BuiltinId> ids;
-  for (const auto& entry : kLibrary)
-    ids.push_back(entry.first);
-  return ids;
+  return idsOf(kLibrary);
 }
 
 Value EngineScope::call(const lang::icm::Builtin& builtin, const std::vector<Value>& args)

@@ -429,6 +429,7 @@ namespace
 /// A call of a Math built-in: its arguments, with the checks every implementation shares.
 struct MathCall
 {
+  lang::icm::BuiltinId id;
   const std::string& file;
   const Expr& call;
   const std::string& name;
@@ -461,55 +462,38 @@ struct MathCall
 
 using MathFunction = Value (*)(const MathCall&);
 
-template <double (*F)(double)>
-Value unary(const MathCall& c)
-{
-  return Value::real(F(c.num(0)));
-}
-
-// Wrappers, so that the overloads of <cmath> are not named by address.
-double fabs1(double x)
-{
-  return std::fabs(x);
-}
-double sqrt1(double x)
-{
-  return std::sqrt(x);
-}
-double sin1(double x)
-{
-  return std::sin(x);
-}
-double cos1(double x)
-{
-  return std::cos(x);
-}
-double tan1(double x)
-{
-  return std::tan(x);
-}
-double asin1(double x)
-{
-  return std::asin(x);
-}
-double acos1(double x)
-{
-  return std::acos(x);
-}
-double atan1(double x)
-{
-  return std::atan(x);
-}
-double exp1(double x)
-{
-  return std::exp(x);
-}
-double log1(double x)
-{
-  return std::log(x);
-}
-
 using lang::icm::BuiltinId;
+
+/// The functions of one real argument.
+Value elementary(const MathCall& c)
+{
+  const double x = c.num(0);
+  switch (c.id)
+  {
+    case BuiltinId::Abs:
+      return Value::real(std::fabs(x));
+    case BuiltinId::Sqrt:
+      return Value::real(std::sqrt(x));
+    case BuiltinId::Sin:
+      return Value::real(std::sin(x));
+    case BuiltinId::Cos:
+      return Value::real(std::cos(x));
+    case BuiltinId::Tan:
+      return Value::real(std::tan(x));
+    case BuiltinId::Asin:
+      return Value::real(std::asin(x));
+    case BuiltinId::Acos:
+      return Value::real(std::acos(x));
+    case BuiltinId::Atan:
+      return Value::real(std::atan(x));
+    case BuiltinId::Exp:
+      return Value::real(std::exp(x));
+    case BuiltinId::Log:
+      return Value::real(std::log(x));
+    default:
+      c.fail(c.call.pos, c.name + ": not a function of one real");
+  }
+}
 
 /// The interpreter's half of the built-in library (the Math entries of lang::icm::builtins()).
 const std::pair<BuiltinId, MathFunction> kMath[] = {
@@ -542,16 +526,16 @@ const std::pair<BuiltinId, MathFunction> kMath[] = {
         c.fail(c.call.pos, "normalize of a zero vector");
       return Value::vector({ v[0] / n, v[1] / n, v[2] / n });
     } },
-  { BuiltinId::Abs, unary<fabs1> },
-  { BuiltinId::Sqrt, unary<sqrt1> },
-  { BuiltinId::Sin, unary<sin1> },
-  { BuiltinId::Cos, unary<cos1> },
-  { BuiltinId::Tan, unary<tan1> },
-  { BuiltinId::Asin, unary<asin1> },
-  { BuiltinId::Acos, unary<acos1> },
-  { BuiltinId::Atan, unary<atan1> },
-  { BuiltinId::Exp, unary<exp1> },
-  { BuiltinId::Log, unary<log1> },
+  { BuiltinId::Abs, elementary },
+  { BuiltinId::Sqrt, elementary },
+  { BuiltinId::Sin, elementary },
+  { BuiltinId::Cos, elementary },
+  { BuiltinId::Tan, elementary },
+  { BuiltinId::Asin, elementary },
+  { BuiltinId::Acos, elementary },
+  { BuiltinId::Atan, elementary },
+  { BuiltinId::Exp, elementary },
+  { BuiltinId::Log, elementary },
   { BuiltinId::Atan2,
     [](const MathCall& c)
     {
@@ -613,10 +597,7 @@ const std::vector<MathFunction>& mathById()
 
 std::vector<lang::icm::BuiltinId> interpreterBuiltins()
 {
-  std::vector<BuiltinId> ids;
-  for (const auto& entry : kMath)
-    ids.push_back(entry.first);
-  return ids;
+  return idsOf(kMath);
 }
 
 Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame& f) const
@@ -632,7 +613,7 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
     const MathFunction fn = mathById()[static_cast<std::size_t>(builtin->id)];
     if (!fn)
       fail(call.pos, name + ": no implementation of this built-in");
-    return fn(MathCall{ file_, call, name, args });
+    return fn(MathCall{ builtin->id, file_, call, name, args });
   }
   if (functions_)
     for (const Procedure& p : *functions_)
