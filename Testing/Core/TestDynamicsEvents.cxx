@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Events (thesis L1327-1333), reactions and the stepper with TIME_REJECTED (§4.4.2 L2061-2082),
-// and locating transitions in time (root finding). Hand-derived values in the comments.
+// and the stepper stopping at a located transition (FRep/RootFinding.h, tested in
+// TestRootFinding.cxx). Hand-derived values in the comments.
 
 #include "Dynamics/Events.h"
-#include "Dynamics/RootFinding.h"
 #include "Dynamics/Stepper.h"
 
 #include <gmock/gmock.h>
@@ -195,63 +195,6 @@ TEST(DynamicsEvents, TimeRejectedLimits)
   EXPECT_THROW(never.step(1.0), StepRejectedError);
   EXPECT_EQ(never.rejections(), 6);
   EXPECT_EQ(never.time(), 0.0); // nothing accepted, state at the last valid time
-}
-
-TEST(DynamicsRootFinding, SignChangeIsRefined)
-{
-  // g(t) = 3 - t on [2.5, 3.7]: one secant step from the bracketing samples lands on 3.
-  auto c = locateCrossing([](double t) { return 3.0 - t; }, 2.5, 3.7);
-  ASSERT_TRUE(c);
-  EXPECT_EQ(c->kind, Crossing::Kind::SignChange);
-  EXPECT_NEAR(c->time, 3.0, 1e-12);
-  // g(t) = t^3 - 2 on [1, 2]: the root is 2^(1/3) = 1.2599210498948732.
-  auto d = locateCrossing([](double t) { return t * t * t - 2.0; }, 1.0, 2.0);
-  ASSERT_TRUE(d);
-  EXPECT_NEAR(d->time, std::cbrt(2.0), 1e-12);
-  // The earliest of two roots: (t - 1.2)(t - 1.7) on [1, 2] -> 1.2.
-  auto e = locateCrossing([](double t) { return (t - 1.2) * (t - 1.7); }, 1.0, 2.0);
-  ASSERT_TRUE(e);
-  EXPECT_NEAR(e->time, 1.2, 1e-12);
-  EXPECT_FALSE(locateCrossing([](double t) { return t + 1.0; }, 0.0, 1.0));
-}
-
-TEST(DynamicsRootFinding, InstantaneousTouchIsFound)
-{
-  // A unit disk passing a rectangle's corner (0,0) along x + y = sqrt(2) at speed sqrt(2):
-  // centre c(t) = (sqrt(2)/2 + s, sqrt(2)/2 - s), s = t - 2.5. While the corner is the nearest
-  // rectangle point, the gap is g = |c| - 1 = sqrt(1 + 2 s^2) - 1 >= 0, zero only at s = 0: a
-  // tangency at t = 2.5 without a sign change. Both ends of the step [2, 3.1] are positive
-  // (g(2) = sqrt(1.5) - 1 = 0.22, g(3.1) = sqrt(1.72) - 1 = 0.31), so a two-sample test misses it.
-  auto g = [](double t)
-  {
-    const double s = t - 2.5;
-    return std::sqrt(1.0 + 2.0 * s * s) - 1.0;
-  };
-  ASSERT_GT(g(2.0), 0.2);
-  ASSERT_GT(g(3.1), 0.3);
-  auto c = locateCrossing(g, 2.0, 3.1);
-  ASSERT_TRUE(c);
-  EXPECT_EQ(c->kind, Crossing::Kind::Touch);
-  // g ~ s^2 is flat below rounding within ~1e-8 of the touch; the parabola-vertex correction
-  // (RootFinding.h) recovers the time of this symmetric touch to rounding.
-  EXPECT_NEAR(c->time, 2.5, 1e-9);
-  EXPECT_LE(std::abs(c->value), 1e-9);
-  // An asymmetric touch, g = 2 s^2 + s^3 with s = t - 1.7 on [1, 2.3] (8 samples, spacing
-  // 0.1625). The vertex of the parabola through s = -h, 0, +h (h = 1e-4 * 2 * 0.1625 = 3.25e-5)
-  // is at -h (gr - gl) / (2 (gl - 2 g0 + gr)) = -h (2 h^3) / (2 * 4 h^2) = -h^2 / 4 = -2.6e-10:
-  // the cubic term biases the touch time by 2.6e-10.
-  auto a = locateCrossing(
-    [](double t)
-    {
-      const double s = t - 1.7;
-      return s * s * (2.0 + s);
-    },
-    1.0, 2.3);
-  ASSERT_TRUE(a);
-  EXPECT_EQ(a->kind, Crossing::Kind::Touch);
-  EXPECT_NEAR(a->time, 1.7 - 3.25e-5 * 3.25e-5 / 4.0, 1e-11);
-  // Passing at distance 1.1 instead (min g = 0.1): no touch.
-  EXPECT_FALSE(locateCrossing([&](double t) { return g(t) + 0.1; }, 2.0, 3.1));
 }
 
 TEST(DynamicsRootFinding, StepperStopsAtTheCrossing)

@@ -3,6 +3,7 @@
 // (Data/Models/icm). Every expected value is derived by hand in the comment next to it.
 #include "Engine/Builtins.h"
 #include "Engine/DynamicModel.h"
+#include "Geometry/Queries.h"
 #include "Lang/Icm.h"
 
 #include <gtest/gtest.h>
@@ -117,12 +118,12 @@ TEST(EngineExemplars, DiskRectangleHalfDisk)
   const Value c = m.value("KL_segment.translation");
   EXPECT_NEAR(c.vec[0], 2.0, 1e-9);
   EXPECT_NEAR(c.vec[1], 0.0, 1e-6);
-  ictk::engine::QueryOptions q;
+  ictk::geometry::QueryOptions q;
   for (const auto& cell : m.cells())
   {
     if (cell.name == "KFL_half_disk")
     {
-      EXPECT_NEAR(ictk::engine::measure(*cell.shape, q), pi / 2, 1e-6);
+      EXPECT_NEAR(ictk::geometry::measure(*cell.shape, q), pi / 2, 1e-6);
     }
   }
 
@@ -135,7 +136,7 @@ TEST(EngineExemplars, DiskRectangleHalfDisk)
   {
     if (cell.name == "KFL_half_disk")
     {
-      EXPECT_NEAR(ictk::engine::measure(*cell.shape, q), 0.6141848493, 1e-6);
+      EXPECT_NEAR(ictk::geometry::measure(*cell.shape, q), 0.6141848493, 1e-6);
     }
   }
 }

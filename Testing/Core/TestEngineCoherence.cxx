@@ -146,7 +146,7 @@ TEST(EngineCoherence, NewtonsCradleMeshesEachBallOnce)
       ASSERT_EQ(m.dimension, 3);
       // The local mesh is centred on the ball's own origin: after placement, on its translation.
       const frep::Point3 c = Centroid(m.vertices());
-      const engine::Vec3 at = a.value(std::string(ball) + ".translation").vec;
+      const geometry::Vec3 at = a.value(std::string(ball) + ".translation").vec;
       EXPECT_NEAR(c[0], at[0], 5e-3) << ball << " t = " << t;
       EXPECT_NEAR(c[1], at[1], 5e-3) << ball << " t = " << t;
       EXPECT_NEAR(std::abs(discretize::enclosedVolume(m.surface)), ballVolume, 0.02 * ballVolume);

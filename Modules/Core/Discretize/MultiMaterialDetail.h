@@ -8,8 +8,7 @@
 //    vertices they join (the topology, before any position);
 //  - MultiMaterialVertices.cxx: where each vertex goes (bisection on edges, the triple line on
 //    faces, the mean inside tetrahedra).
-// The install copies every *.h under Modules/Core, so this header is installed too, but it is not
-// part of the API: its declarations may change freely.
+// Not installed (PRIVATE_HEADERS in CMakeLists.txt): its declarations may change freely.
 
 #include "Discretize/MultiMaterial.h"
 #include "FRep/Sampling.h"

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to the Discretize library: the pieces of contourSurface (Surface.h), shared by the
-// files that implement it. The install copies every *.h under Modules/Core, so this header is
-// installed too, but it is not part of the API: its declarations may change freely.
+// files that implement it. Not installed (PRIVATE_HEADERS in CMakeLists.txt): its declarations
+// may change freely.
 //
 // Manifold dual contouring (Ju et al. 2002; Schaefer, Ju & Warren 2007) over an interval-pruned
 // octree, one concern per file (as Fidget splits its mesher into octree, QEF and dual contouring):

@@ -330,8 +330,9 @@ int Stepper::step(double dt)
   return frames;
 }
 
-std::optional<Crossing> Stepper::stepUntil(double dt,
-  const std::function<double(const ParameterTable&, double)>& guard, const LocateOptions& options)
+std::optional<frep::Crossing> Stepper::stepUntil(double dt,
+  const std::function<double(const ParameterTable&, double)>& guard,
+  const frep::LocateOptions& options)
 {
   const Snapshot start = save();
   const double t0 = t_;
@@ -342,7 +343,7 @@ std::optional<Crossing> Stepper::stepUntil(double dt,
       step(tau - t0);
     return guard(params_, tau);
   };
-  std::optional<Crossing> c = locateCrossing(g, t0, t0 + dt, options);
+  std::optional<frep::Crossing> c = frep::locateCrossing(g, t0, t0 + dt, options);
   restore(start);
   const double to = c ? c->time : t0 + dt;
   if (to > t0)

@@ -38,8 +38,8 @@
 #include "Dynamics/Dependencies.h"
 #include "Dynamics/Events.h"
 #include "Dynamics/Parameters.h"
-#include "Dynamics/RootFinding.h"
 #include "Dynamics/Time.h"
+#include "FRep/RootFinding.h"
 
 #include <any>
 #include <functional>
@@ -156,9 +156,9 @@ public:
   /// Advances by dt unless guard(params, t) reaches 0 inside the step (locateCrossing); then
   /// stops exactly at the located time and returns the crossing. The guard is probed by
   /// re-running the step from the saved state to each probe time.
-  std::optional<Crossing> stepUntil(double dt,
+  std::optional<frep::Crossing> stepUntil(double dt,
     const std::function<double(const ParameterTable&, double)>& guard,
-    const LocateOptions& options = {});
+    const frep::LocateOptions& options = {});
 
   struct Snapshot
   {

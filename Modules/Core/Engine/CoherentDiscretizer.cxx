@@ -3,6 +3,7 @@
 
 #include "Complex/Attributes.h"
 #include "FRep/Sampling.h"
+#include "Geometry/ShapeCells.h"
 
 #include <algorithm>
 #include <cctype>
@@ -13,6 +14,11 @@
 
 namespace ictk::engine
 {
+using geometry::Affine;
+using geometry::PlacedShape;
+using geometry::ShapePart;
+using geometry::Vec3;
+
 namespace
 {
 
@@ -21,7 +27,7 @@ bool sameAffine(const Affine& a, const Affine& b)
   return a.a == b.a && a.b == b.b;
 }
 
-bool hasWorldParts(const Shape& s)
+bool hasWorldParts(const PlacedShape& s)
 {
   return std::any_of(s.parts.begin(), s.parts.end(),
     [](const ShapePart& p)
@@ -183,7 +189,7 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
     {
       throw std::invalid_argument("cell '" + state.name + "' has no shape");
     }
-    const Shape& shape = *state.shape;
+    const PlacedShape& shape = *state.shape;
     const bool worldParts = hasWorldParts(shape);
     // World-space parts ignore the placement of a local frame: such a shape is meshed where it
     // is, and its mesh holds for that placement only.
@@ -211,7 +217,7 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
     }
     else
     {
-      Shape local = shape;
+      PlacedShape local = shape;
       if (!worldParts)
       {
         local.place = Affine{};

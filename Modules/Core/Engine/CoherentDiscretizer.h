@@ -47,7 +47,7 @@ struct CoherenceOptions
   /// Threads of the discretisers; 0 = TBB's default. The result does not depend on it.
   int threads = 0;
   /// How circular parts become explicit cells (toComplexCell).
-  QueryOptions geometry;
+  geometry::QueryOptions geometry;
   /// Called with the completed fraction of a frame; return false to cancel (frep::Cancelled).
   Progress progress;
 };
@@ -109,9 +109,9 @@ private:
     complex::CellMesh local;
     /// Shapes with world-space parts: their mesh is only valid under this placement.
     bool worldParts = false;
-    Affine madeUnder;
+    geometry::Affine madeUnder;
     /// The placement of the previous frame, to tell a moved cell from a resting one.
-    Affine lastPlace;
+    geometry::Affine lastPlace;
   };
   CoherenceOptions options_;
   double featureSize_ = 0;

@@ -3,6 +3,8 @@
 
 #include "Engine/Builtins.h"
 #include "Engine/ModelState.h"
+#include "Geometry/Queries.h"
+#include "Geometry/ShapeCells.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 
@@ -1073,12 +1075,12 @@ Affine ModelState::place(const std::string& cell, int depth) const
   return local;
 }
 
-ShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
+PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
 {
   if (depth > static_cast<int>(cells.size()))
     throw std::runtime_error("the shapes of blend/union cells refer to each other in a cycle");
   const CellSpec& c = cells[cellIndex.at(cell)];
-  auto shape = std::make_shared<Shape>();
+  auto shape = std::make_shared<PlacedShape>();
   shape->cell = c.name;
   shape->dimension = c.dimension;
   shape->place = place(cell);
@@ -1477,7 +1479,7 @@ bool EngineScope::assign(const std::string& name, const std::string& member, con
   return false;
 }
 
-ShapePtr EngineScope::cellShape(const Value& v) const
+PlacedShapePtr EngineScope::cellShape(const Value& v) const
 {
   if (v.type != Value::Type::Cell)
     throw std::runtime_error(std::string("expected a cell, got a ") + typeName(v.type));
@@ -1504,19 +1506,19 @@ using lang::icm::BuiltinId;
 
 Value distanceOf(const LibraryCall& c)
 {
-  return Value::real(engine::distance(
+  return Value::real(geometry::distance(
     *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
 }
 
 Value intersectsOf(const LibraryCall& c)
 {
-  return Value::boolean(engine::intersects(
+  return Value::boolean(geometry::intersects(
     *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
 }
 
 Value containsOf(const LibraryCall& c)
 {
-  return Value::boolean(engine::contains(
+  return Value::boolean(geometry::contains(
     *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
 }
 
@@ -1958,7 +1960,7 @@ complex::Complex DynamicModel::complex() const
     auto a = m.attributes.find(name);
     if (a == m.attributes.end() || !a->second.tape || !ids.count(cell))
       continue;
-    Shape local;
+    PlacedShape local;
     local.cell = cell;
     local.dimension = 3;
     local.place = m.place(cell);

@@ -14,8 +14,8 @@
 #include "Complex/Complex.h"
 #include "Dynamics/Dependencies.h"
 #include "Engine/Interpreter.h"
-#include "Engine/Shapes.h"
 #include "FRep/Progress.h"
+#include "Geometry/PlacedShape.h"
 #include "Lang/Icm.h"
 
 #include <functional>
@@ -34,8 +34,8 @@ struct RunOptions
   /// Transitions between instances are located to this time (bisection on the identity of the
   /// valid instance, so an instance valid only around an instant, such as a tangency, is found).
   double timeTolerance = 1e-9;
-  /// Geometric tolerance of the reaction library (Shapes.h QueryOptions; 0 = relative default).
-  QueryOptions geometry;
+  /// Geometric tolerance of the reaction library (geometry::QueryOptions; 0 = relative default).
+  geometry::QueryOptions geometry;
   /// Dependency cycles: every relation on a cycle reads the previous frame (Dependencies.h).
   dyn::CyclePolicy cycles = dyn::CyclePolicy::PreviousState;
   /// Progress and cancellation for long runs: called after every evaluated time with the fraction
@@ -61,7 +61,7 @@ struct CellState
   std::string name;
   complex::CellKind kind = complex::CellKind::FRep;
   int dimension = 3;
-  ShapePtr shape; ///< placed in the world
+  geometry::PlacedShapePtr shape; ///< placed in the world
   /// Changes whenever the shape's parts change (a reaction set the shape, a shape parameter
   /// changed, an operand of a blend or union moved); a change of placement alone keeps it, so a
   /// discretisation of the local shape stays valid and only needs moving (time coherence, thesis
@@ -97,8 +97,9 @@ public:
   /// The cells of the active instance that have a shape now (a T-cell whose shape no reaction has
   /// set yet is left out), in the instance's order.
   std::vector<CellState> cells() const;
-  /// The implicit complex of the active instance now: its cells (Shapes.h toComplexCell) and its
-  /// boundary and containment relations. Cell ids follow cells(): id i is cells()[i].
+  /// The implicit complex of the active instance now: its cells (Geometry/ShapeCells.h
+  /// toComplexCell) and its boundary and containment relations. Cell ids follow cells(): id i is
+  /// cells()[i].
   complex::Complex complex() const;
 
   /// A value by path: a state or instance parameter ("isIntersection"), a cell parameter or

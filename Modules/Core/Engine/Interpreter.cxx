@@ -13,6 +13,7 @@
 namespace ictk::engine
 {
 
+using geometry::Vec3;
 using lang::icm::Expr;
 using lang::icm::Pos;
 using lang::icm::Procedure;

@@ -6,7 +6,7 @@
 // cells or instances. Every loop is bounded and every call goes to a built-in or to a function
 // defined earlier, so all code ends; errors are ModelError with the file, line and column.
 
-#include "Engine/Shapes.h"
+#include "Geometry/PlacedShape.h"
 #include "Lang/IcmAst.h"
 #include "Lang/IcmBuiltins.h"
 
@@ -45,15 +45,15 @@ struct Value
   };
   Type type = Type::None;
   double number = 0.0;
-  Vec3 vec{ 0, 0, 0 };
+  geometry::Vec3 vec{ 0, 0, 0 };
   std::string text;
-  std::shared_ptr<const std::vector<ShapePart>> shape;
+  std::shared_ptr<const std::vector<geometry::ShapePart>> shape;
   std::map<std::string, double> fields; ///< Event parameters
 
   static Value real(double v);
   static Value integer(double v);
   static Value boolean(bool v);
-  static Value vector(const Vec3& v);
+  static Value vector(const geometry::Vec3& v);
   static Value string(std::string s);
   static Value cell(std::string name);
   bool isNumber() const { return type == Type::Real || type == Type::Int; }

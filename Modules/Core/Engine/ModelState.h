@@ -19,6 +19,12 @@
 namespace ictk::engine
 {
 
+using geometry::Affine;
+using geometry::PlacedShape;
+using geometry::PlacedShapePtr;
+using geometry::QueryOptions;
+using geometry::ShapePart;
+using geometry::Vec3;
 using lang::icm::CellDef;
 using lang::icm::Expr;
 using lang::icm::ExprPtr;
@@ -214,7 +220,7 @@ struct ModelState
   std::shared_ptr<const std::vector<ShapePart>> partsOf(const CellSpec& c) const;
   Affine localPlace(const std::string& cell) const;
   Affine place(const std::string& cell, int depth = 0) const;
-  ShapePtr shapeOf(const std::string& cell, int depth = 0) const;
+  PlacedShapePtr shapeOf(const std::string& cell, int depth = 0) const;
   std::uint64_t versionOf(const std::string& cell, int depth = 0) const;
   void bumpVersion(const std::string& cell) { s.versions[cell] = nextVersion++; }
 
@@ -251,7 +257,7 @@ public:
   ModelState& model() const { return m_; }
   /// The placed shape of a cell argument (std::runtime_error for another value or a T-cell
   /// without a shape yet).
-  ShapePtr cellShape(const Value& v) const;
+  PlacedShapePtr cellShape(const Value& v) const;
 
 private:
   /// The qualified parameter a bare name stands for, or "".

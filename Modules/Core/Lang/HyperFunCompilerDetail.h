@@ -2,9 +2,8 @@
 #pragma once
 // Internal to the Lang library: the HyperFun compiler (HyperFunCompiler.h) shared by its two
 // files: HyperFunCompiler.cxx (values, expressions, user calls, statements, the model's entry
-// point) and HyperFunLibrary.cxx (the built-in math functions and the hf* library table). The
-// install copies every *.h under Modules/Core, so this header is installed too, but it is not part
-// of the API: its declarations may change freely.
+// point) and HyperFunLibrary.cxx (the built-in math functions and the hf* library table). Not
+// installed (PRIVATE_HEADERS in CMakeLists.txt): its declarations may change freely.
 
 #include "Lang/HyperFunCompiler.h"
 

@@ -1,6 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Locating transitions in time (issue 5: "transitions located in time ... so that instantaneous
-// states such as the tangency in thesis 5.1 are found, not skipped by a coarse step").
+// Roots of a scalar function of one variable: refineRoot() (Illinois) and locateCrossing()
+// (sampling, Illinois, golden section for touches). Numerics, not time or geometry, so it sits in
+// the kernel below both of its users: Dynamics locates transitions in time with it (issue 5:
+// "transitions located in time ... so that instantaneous states such as the tangency in thesis 5.1
+// are found, not skipped by a coarse step"), and Geometry refines meeting points along a curve's
+// parameter (Geometry/MeetingPoints.cxx). The variable is called t and "time" below, as in its
+// first use.
 //
 // Given a scalar g(t) over the model state (a signed distance, an overlap area minus a target...)
 // and a step [t0, t1], locateCrossing() returns the earliest time in (t0, t1] where g reaches 0:
@@ -31,7 +36,7 @@
 #include <functional>
 #include <optional>
 
-namespace ictk::dyn
+namespace ictk::frep
 {
 
 struct LocateOptions
@@ -64,4 +69,4 @@ double refineRoot(const std::function<double(double)>& g, double a, double ga, d
 std::optional<Crossing> locateCrossing(
   const std::function<double(double)>& g, double t0, double t1, const LocateOptions& options = {});
 
-} // namespace ictk::dyn
+} // namespace ictk::frep

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "Engine/Shapes.h"
+#include "Geometry/PlacedShape.h"
+#include "Geometry/Queries.h"
+#include "Geometry/ShapeCells.h"
 
 #include "Complex/Cell.h"
 #include "FRep/Expr.h"
@@ -17,10 +19,10 @@ namespace
 {
 
 using namespace ictk;
-using engine::Affine;
-using engine::Shape;
-using engine::ShapePart;
-using engine::Vec3;
+using geometry::Affine;
+using geometry::PlacedShape;
+using geometry::ShapePart;
+using geometry::Vec3;
 
 constexpr double Pi = 3.14159265358979323846;
 // r^2 acos(d / r) - d sqrt(r^2 - d^2) for r = 1, d = 0.5: acos(0.5) = pi / 3, sqrt(0.75).
@@ -31,9 +33,10 @@ Affine at(double x, double y, double z = 0)
   return Affine::fromTransform({ x, y, z }, { 0, 0, 0 }, { 1, 1, 1 });
 }
 
-Shape shapeOf(const std::string& name, int dimension, ShapePart part, const Affine& place = {})
+PlacedShape shapeOf(
+  const std::string& name, int dimension, ShapePart part, const Affine& place = {})
 {
-  Shape s;
+  PlacedShape s;
   s.cell = name;
   s.dimension = dimension;
   s.parts.push_back(std::move(part));
@@ -41,7 +44,7 @@ Shape shapeOf(const std::string& name, int dimension, ShapePart part, const Affi
   return s;
 }
 
-Shape disk(double r, const Affine& place, const std::string& name = "disk")
+PlacedShape disk(double r, const Affine& place, const std::string& name = "disk")
 {
   ShapePart p;
   p.kind = ShapePart::Kind::Disk;
@@ -49,7 +52,8 @@ Shape disk(double r, const Affine& place, const std::string& name = "disk")
   return shapeOf(name, 2, p, place);
 }
 
-Shape rectangle(double w, double h, const Affine& place, const std::string& name = "rectangle")
+PlacedShape rectangle(
+  double w, double h, const Affine& place, const std::string& name = "rectangle")
 {
   ShapePart p;
   p.kind = ShapePart::Kind::Rectangle;
@@ -57,7 +61,7 @@ Shape rectangle(double w, double h, const Affine& place, const std::string& name
   return shapeOf(name, 2, p, place);
 }
 
-Shape segment(const Vec3& a, const Vec3& b, const std::string& name = "segment")
+PlacedShape segment(const Vec3& a, const Vec3& b, const std::string& name = "segment")
 {
   ShapePart p;
   p.kind = ShapePart::Kind::Segment;
@@ -65,7 +69,7 @@ Shape segment(const Vec3& a, const Vec3& b, const std::string& name = "segment")
   return shapeOf(name, 1, p);
 }
 
-Shape sphere(double r, const Affine& place, const std::string& name = "sphere")
+PlacedShape sphere(double r, const Affine& place, const std::string& name = "sphere")
 {
   ShapePart p;
   p.kind = ShapePart::Kind::Sphere;
@@ -79,7 +83,7 @@ frep::FieldPtr fieldOf(const frep::Expr& e)
 }
 
 /// The HyperFun-style disk r^2 - x^2 - y^2 (not a distance) as a 2D Field part.
-Shape fieldDisk(double r, const Affine& place, const std::string& name = "fieldDisk")
+PlacedShape fieldDisk(double r, const Affine& place, const std::string& name = "fieldDisk")
 {
   using frep::Expr;
   ShapePart p;
@@ -90,7 +94,7 @@ Shape fieldDisk(double r, const Affine& place, const std::string& name = "fieldD
   return shapeOf(name, 2, p, place);
 }
 
-Shape fieldSphere(double r, const Affine& place, const std::string& name = "fieldSphere")
+PlacedShape fieldSphere(double r, const Affine& place, const std::string& name = "fieldSphere")
 {
   using frep::Expr;
   ShapePart p;
@@ -122,7 +126,7 @@ double microseconds(int repeats, const F& f)
 
 } // namespace
 
-TEST(EngineAffine, FromTransformScalesThenRotatesXYZThenTranslates)
+TEST(GeometryAffine, FromTransformScalesThenRotatesXYZThenTranslates)
 {
   // (1, 0, 0) scaled by (2, 1, 1) is (2, 0, 0); Rz(90 deg) turns it to (0, 2, 0); + (1, 2, 3).
   const Affine m = Affine::fromTransform({ 1, 2, 3 }, { 0, 0, Pi / 2 }, { 2, 1, 1 });
@@ -145,7 +149,7 @@ TEST(EngineAffine, FromTransformScalesThenRotatesXYZThenTranslates)
   EXPECT_FALSE(m.isIdentity());
 }
 
-TEST(EngineAffine, InverseAndComposition)
+TEST(GeometryAffine, InverseAndComposition)
 {
   const Affine m = Affine::fromTransform({ 1, -2, 0.5 }, { 0.3, -0.7, 1.1 }, { 2, 0.5, 3 });
   const Affine n = Affine::fromTransform({ -4, 0, 1 }, { 1.0, 0.2, -0.4 }, { 1, 1, 0.25 });
@@ -163,10 +167,10 @@ TEST(EngineAffine, InverseAndComposition)
     Affine::fromTransform({ 0, 0, 0 }, { 0, 0, 0 }, { 1, 0, 1 }).inverse(), std::invalid_argument);
 }
 
-TEST(EngineShapes, ValuesOfEachPart)
+TEST(GeometryShapes, ValuesOfEachPart)
 {
   // Rectangle 4 x 2 at (1, 0): min(2 - |x - 1|, 1 - |y|).
-  const Shape r = rectangle(4, 2, at(1, 0));
+  const PlacedShape r = rectangle(4, 2, at(1, 0));
   EXPECT_DOUBLE_EQ(r.value({ 1, 0, 0 }), 1);
   EXPECT_DOUBLE_EQ(r.value({ 4, 0, 0 }), -1);
   EXPECT_DOUBLE_EQ(r.value({ 1, 0, 7 }), 1); // 2D: z ignored
@@ -174,11 +178,11 @@ TEST(EngineShapes, ValuesOfEachPart)
   EXPECT_DOUBLE_EQ(disk(1, at(1.5, 0)).value({ 0, 0, 0 }), -0.5);
   // Rotated and scaled: a rectangle 1 x 1 scaled by 2 along local x, turned 90 degrees, is
   // 1 wide and 2 tall; (0, 0.9) is local (0.45, 0): 0.5 - 0.45.
-  const Shape turned =
+  const PlacedShape turned =
     rectangle(1, 1, Affine::fromTransform({ 0, 0, 0 }, { 0, 0, Pi / 2 }, { 2, 1, 1 }));
   EXPECT_NEAR(turned.value({ 0, 0.9, 0 }), 0.05, 1e-15);
   // Field 1 - x^2 - y^2 at (2, 0), clipped by its domain [-1.5, 1.5]^2.
-  const Shape f = fieldDisk(1, at(2, 0));
+  const PlacedShape f = fieldDisk(1, at(2, 0));
   EXPECT_NEAR(f.value({ 2.5, 0, 0 }), 0.75, 1e-15);
   EXPECT_NEAR(f.value({ 2, 0, 0 }), 1, 1e-15);
   // At local (1.4, 0): field 1 - 1.96 = -0.96, box 0.1: min is the field's.
@@ -192,14 +196,14 @@ TEST(EngineShapes, ValuesOfEachPart)
   EXPECT_DOUBLE_EQ(shapeOf("box", 3, box).value({ 0, 0, 3.5 }), -0.5);
   // Blend of two unit disks at (-1.5, 0) and (1.5, 0), amount 0.5, at the origin: f1 = f2 =
   // -0.5, so -1 + sqrt(0.5) + 0.5 / (1 + 0.25 + 0.25) = 0.0404401145...
-  auto a = std::make_shared<Shape>(disk(1, at(-1.5, 0), "a"));
-  auto b = std::make_shared<Shape>(disk(1, at(1.5, 0), "b"));
+  auto a = std::make_shared<PlacedShape>(disk(1, at(-1.5, 0), "a"));
+  auto b = std::make_shared<PlacedShape>(disk(1, at(1.5, 0), "b"));
   ShapePart blend;
   blend.kind = ShapePart::Kind::Blend;
   blend.operandA = a;
   blend.operandB = b;
   blend.amount = 0.5;
-  const Shape blended = shapeOf("blend", 2, blend);
+  const PlacedShape blended = shapeOf("blend", 2, blend);
   EXPECT_NEAR(blended.value({ 0, 0, 0 }), -1 + std::sqrt(0.5) + 0.5 / 1.5, 1e-15);
   EXPECT_GT(blended.value({ 0, 0, 0 }), 0); // the bump fills the gap between the disks
   ShapePart uni = blend;
@@ -210,24 +214,24 @@ TEST(EngineShapes, ValuesOfEachPart)
   EXPECT_THROW(segment({ 0, 0, 0 }, { 1, 0, 0 }).value({ 0, 0, 0 }), std::invalid_argument);
 }
 
-TEST(EngineShapes, WorldBounds)
+TEST(GeometryShapes, WorldBounds)
 {
   // A unit disk turned by 30 degrees and stretched 2x along local x: the ellipse's half-widths
   // are sqrt(a00^2 + a01^2) = sqrt((2 cos 30)^2 + sin^2 30) = sqrt(3.25) along x.
-  const Shape e = disk(1, Affine::fromTransform({ 1, 0, 0 }, { 0, 0, Pi / 6 }, { 2, 1, 1 }));
+  const PlacedShape e = disk(1, Affine::fromTransform({ 1, 0, 0 }, { 0, 0, Pi / 6 }, { 2, 1, 1 }));
   const auto b = e.worldBounds();
   EXPECT_NEAR(b.hi[0], 1 + std::sqrt(3.25), 1e-14);
   EXPECT_NEAR(b.lo[1], -std::sqrt(1 + 0.75), 1e-14);
 }
 
 // A unit disk moving along x touches the line x = 2 when its centre reaches x = 1.
-TEST(EngineShapes, TangencyOfDiskAndLine)
+TEST(GeometryShapes, TangencyOfDiskAndLine)
 {
-  const Shape line = segment({ 2, -3, 0 }, { 2, 3, 0 }, "line");
-  const Shape wall = rectangle(2, 2, at(3, 0), "wall"); // its left side is x = 2
+  const PlacedShape line = segment({ 2, -3, 0 }, { 2, 3, 0 }, "line");
+  const PlacedShape wall = rectangle(2, 2, at(3, 0), "wall"); // its left side is x = 2
   // Crossing at centre 1 + 1e-3: y = +-sqrt(1 - (1 - 1e-3)^2) = +-sqrt(1.999e-3).
   const double y = std::sqrt(1 - (1 - 1e-3) * (1 - 1e-3));
-  for (const Shape* other : { &line, &wall })
+  for (const PlacedShape* other : { &line, &wall })
   {
     for (bool field : { false, true })
     {
@@ -236,43 +240,43 @@ TEST(EngineShapes, TangencyOfDiskAndLine)
       {
         return field ? fieldDisk(1, at(c, 0)) : disk(1, at(c, 0));
       };
-      auto touching = engine::intersectionPoints(moving(1), *other);
+      auto touching = geometry::intersectionPoints(moving(1), *other);
       ASSERT_EQ(touching.size(), 1u);
       expectPoint(touching[0], 2, 0, 1e-7);
-      EXPECT_TRUE(engine::intersects(moving(1), *other));
-      EXPECT_EQ(engine::intersectionPoints(moving(1 - 1e-3), *other).size(), 0u);
-      EXPECT_FALSE(engine::intersects(moving(1 - 1e-3), *other));
-      auto crossing = engine::intersectionPoints(moving(1 + 1e-3), *other);
+      EXPECT_TRUE(geometry::intersects(moving(1), *other));
+      EXPECT_EQ(geometry::intersectionPoints(moving(1 - 1e-3), *other).size(), 0u);
+      EXPECT_FALSE(geometry::intersects(moving(1 - 1e-3), *other));
+      auto crossing = geometry::intersectionPoints(moving(1 + 1e-3), *other);
       ASSERT_EQ(crossing.size(), 2u);
       expectPoint(crossing[0], 2, -y, 1e-9);
       expectPoint(crossing[1], 2, y, 1e-9);
       // The same from the other side of the call.
-      EXPECT_EQ(engine::intersectionPoints(*other, moving(1 + 1e-3)).size(), 2u);
+      EXPECT_EQ(geometry::intersectionPoints(*other, moving(1 + 1e-3)).size(), 2u);
     }
   }
 }
 
-TEST(EngineShapes, SegmentAgainstRectangle)
+TEST(GeometryShapes, SegmentAgainstRectangle)
 {
-  const Shape r = rectangle(4, 2, {});
-  auto through = engine::intersectionPoints(segment({ 0, 1.5, 0 }, { 0, -1.5, 0 }), r);
+  const PlacedShape r = rectangle(4, 2, {});
+  auto through = geometry::intersectionPoints(segment({ 0, 1.5, 0 }, { 0, -1.5, 0 }), r);
   ASSERT_EQ(through.size(), 2u);
   expectPoint(through[0], 0, -1, 1e-12); // sorted by x, then y
   expectPoint(through[1], 0, 1, 1e-12);
-  auto ending = engine::intersectionPoints(segment({ 0, 0.5, 0 }, { 0, 1.5, 0 }), r);
+  auto ending = geometry::intersectionPoints(segment({ 0, 0.5, 0 }, { 0, 1.5, 0 }), r);
   ASSERT_EQ(ending.size(), 1u);
   expectPoint(ending[0], 0, 1, 1e-12);
   // From inside out through the corner (2, 1): one point, not one per edge.
-  auto corner = engine::intersectionPoints(segment({ 1, 0, 0 }, { 3, 2, 0 }), r);
+  auto corner = geometry::intersectionPoints(segment({ 1, 0, 0 }, { 3, 2, 0 }), r);
   ASSERT_EQ(corner.size(), 1u);
   expectPoint(corner[0], 2, 1, 1e-12);
   // Two disks of radius 1 at (0, 0) and (1, 0): x = 0.5, y = +-sqrt(0.75).
-  auto lens = engine::intersectionPoints(disk(1, {}), disk(1, at(1, 0)));
+  auto lens = geometry::intersectionPoints(disk(1, {}), disk(1, at(1, 0)));
   ASSERT_EQ(lens.size(), 2u);
   expectPoint(lens[0], 0.5, -std::sqrt(0.75), 1e-12);
   expectPoint(lens[1], 0.5, std::sqrt(0.75), 1e-12);
   // A field disk against a field disk: the same points, after Newton on both.
-  auto fields = engine::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(1, 0)));
+  auto fields = geometry::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(1, 0)));
   ASSERT_EQ(fields.size(), 2u);
   expectPoint(fields[0], 0.5, -std::sqrt(0.75), 1e-7);
   expectPoint(fields[1], 0.5, std::sqrt(0.75), 1e-7);
@@ -283,85 +287,87 @@ TEST(EngineShapes, SegmentAgainstRectangle)
   arc.radius = 1;
   arc.points = { { 1, 0, 0 }, { -1, 0, 0 } };
   auto arcHits =
-    engine::intersectionPoints(shapeOf("arc", 1, arc), segment({ -2, 0.5, 0 }, { 2, 0.5, 0 }));
+    geometry::intersectionPoints(shapeOf("arc", 1, arc), segment({ -2, 0.5, 0 }, { 2, 0.5, 0 }));
   ASSERT_EQ(arcHits.size(), 2u);
   expectPoint(arcHits[0], -std::sqrt(0.75), 0.5, 1e-12);
   EXPECT_EQ(
-    engine::intersectionPoints(shapeOf("arc", 1, arc), segment({ -2, -0.5, 0 }, { 2, -0.5, 0 }))
+    geometry::intersectionPoints(shapeOf("arc", 1, arc), segment({ -2, -0.5, 0 }, { 2, -0.5, 0 }))
       .size(),
     0u);
 }
 
-TEST(EngineShapes, Distances)
+TEST(GeometryShapes, Distances)
 {
   // Disks of radius 1 with centres 3 apart: 3 - 2.
-  EXPECT_NEAR(engine::distance(disk(1, {}), disk(1, at(3, 0))), 1, 1e-12);
+  EXPECT_NEAR(geometry::distance(disk(1, {}), disk(1, at(3, 0))), 1, 1e-12);
   // The segment x = 3 to the unit disk: 3 - 1; to the rectangle [-2, 2] x [-1, 1]: 1.
-  EXPECT_NEAR(engine::distance(segment({ 3, -1, 0 }, { 3, 1, 0 }), disk(1, {})), 2, 1e-12);
-  EXPECT_NEAR(engine::distance(segment({ 3, -1, 0 }, { 3, 1, 0 }), rectangle(4, 2, {})), 1, 1e-12);
+  EXPECT_NEAR(geometry::distance(segment({ 3, -1, 0 }, { 3, 1, 0 }), disk(1, {})), 2, 1e-12);
+  EXPECT_NEAR(
+    geometry::distance(segment({ 3, -1, 0 }, { 3, 1, 0 }), rectangle(4, 2, {})), 1, 1e-12);
   // Rectangle corner (2, 1) to the disk at (4, 3): sqrt(8) - 1.
-  EXPECT_NEAR(engine::distance(rectangle(4, 2, {}), disk(1, at(4, 3))), std::sqrt(8.0) - 1, 1e-9);
+  EXPECT_NEAR(geometry::distance(rectangle(4, 2, {}), disk(1, at(4, 3))), std::sqrt(8.0) - 1, 1e-9);
   // Overlapping and contained shapes are at distance 0.
-  EXPECT_EQ(engine::distance(rectangle(4, 2, {}), disk(0.1, at(0.5, 0))), 0);
+  EXPECT_EQ(geometry::distance(rectangle(4, 2, {}), disk(0.1, at(0.5, 0))), 0);
   // Spheres: analytic, then as fields (alternating projections).
   EXPECT_NEAR(
-    engine::distance(sphere(0.5, at(-0.75, 0, 0)), sphere(0.5, at(0.75, 0, 0))), 0.5, 1e-15);
-  EXPECT_NEAR(engine::distance(fieldSphere(0.5, at(-0.75, 0, 0)), fieldSphere(0.5, at(0.75, 0, 0))),
-    0.5, 1e-6);
+    geometry::distance(sphere(0.5, at(-0.75, 0, 0)), sphere(0.5, at(0.75, 0, 0))), 0.5, 1e-15);
+  EXPECT_NEAR(
+    geometry::distance(fieldSphere(0.5, at(-0.75, 0, 0)), fieldSphere(0.5, at(0.75, 0, 0))), 0.5,
+    1e-6);
   // A field disk (radius 1 at the origin) to the line x = 3: 2.
-  EXPECT_NEAR(engine::distance(fieldDisk(1, {}), segment({ 3, -1, 0 }, { 3, 1, 0 })), 2, 1e-6);
+  EXPECT_NEAR(geometry::distance(fieldDisk(1, {}), segment({ 3, -1, 0 }, { 3, 1, 0 })), 2, 1e-6);
   // A box 2 x 2 x 2 at the origin to a sphere of radius 1 at (4, 0, 0): 4 - 1 - 1.
   ShapePart box;
   box.kind = ShapePart::Kind::Box;
   box.size = { 2, 2, 2 };
-  EXPECT_NEAR(engine::distance(shapeOf("box", 3, box), sphere(1, at(4, 0, 0))), 2, 1e-9);
+  EXPECT_NEAR(geometry::distance(shapeOf("box", 3, box), sphere(1, at(4, 0, 0))), 2, 1e-9);
 }
 
-TEST(EngineShapes, IntersectsIsCertifiedForFields)
+TEST(GeometryShapes, IntersectsIsCertifiedForFields)
 {
   // Field spheres of radius 0.5: centres 1.5 apart do not meet, 0.9 apart do.
   EXPECT_FALSE(
-    engine::intersects(fieldSphere(0.5, at(-0.75, 0, 0)), fieldSphere(0.5, at(0.75, 0, 0))));
+    geometry::intersects(fieldSphere(0.5, at(-0.75, 0, 0)), fieldSphere(0.5, at(0.75, 0, 0))));
   EXPECT_TRUE(
-    engine::intersects(fieldSphere(0.5, at(-0.45, 0, 0)), fieldSphere(0.5, at(0.45, 0, 0))));
-  EXPECT_TRUE(engine::intersects(fieldDisk(1, {}), rectangle(1, 1, at(1.2, 0))));
-  EXPECT_FALSE(engine::intersects(fieldDisk(1, {}), rectangle(1, 1, at(1.6, 0))));
-  EXPECT_TRUE(engine::intersects(disk(1, {}), disk(1, at(2, 0)))); // tangent
-  EXPECT_FALSE(engine::intersects(disk(1, {}), disk(1, at(2.001, 0))));
+    geometry::intersects(fieldSphere(0.5, at(-0.45, 0, 0)), fieldSphere(0.5, at(0.45, 0, 0))));
+  EXPECT_TRUE(geometry::intersects(fieldDisk(1, {}), rectangle(1, 1, at(1.2, 0))));
+  EXPECT_FALSE(geometry::intersects(fieldDisk(1, {}), rectangle(1, 1, at(1.6, 0))));
+  EXPECT_TRUE(geometry::intersects(disk(1, {}), disk(1, at(2, 0)))); // tangent
+  EXPECT_FALSE(geometry::intersects(disk(1, {}), disk(1, at(2.001, 0))));
 }
 
-TEST(EngineShapes, Contains)
+TEST(GeometryShapes, Contains)
 {
-  const Shape r = rectangle(4, 2, {});
-  EXPECT_TRUE(engine::contains(r, disk(0.5, at(1, 0))));
-  EXPECT_FALSE(engine::contains(r, disk(0.5, at(1.8, 0)))); // 1.8 + 0.5 > 2
-  EXPECT_TRUE(engine::contains(r, segment({ -1, 0, 0 }, { 1.5, 0.5, 0 })));
-  EXPECT_FALSE(engine::contains(r, segment({ -1, 0, 0 }, { 2.5, 0.5, 0 })));
+  const PlacedShape r = rectangle(4, 2, {});
+  EXPECT_TRUE(geometry::contains(r, disk(0.5, at(1, 0))));
+  EXPECT_FALSE(geometry::contains(r, disk(0.5, at(1.8, 0)))); // 1.8 + 0.5 > 2
+  EXPECT_TRUE(geometry::contains(r, segment({ -1, 0, 0 }, { 1.5, 0.5, 0 })));
+  EXPECT_FALSE(geometry::contains(r, segment({ -1, 0, 0 }, { 2.5, 0.5, 0 })));
   // A field disk of radius 1 holds a field disk of radius 0.5 centred at 0.4, not at 0.6.
-  EXPECT_TRUE(engine::contains(fieldDisk(1, {}), fieldDisk(0.5, at(0.4, 0))));
-  EXPECT_FALSE(engine::contains(fieldDisk(1, {}), fieldDisk(0.5, at(0.6, 0))));
-  EXPECT_TRUE(engine::contains(fieldSphere(1, {}), sphere(0.3, at(0.5, 0, 0))));
-  EXPECT_FALSE(engine::contains(fieldSphere(1, {}), sphere(0.3, at(0.8, 0, 0))));
-  EXPECT_TRUE(engine::contains(r, r)); // up to the tolerance
-  EXPECT_THROW(engine::contains(segment({ 0, 0, 0 }, { 1, 0, 0 }), r), std::invalid_argument);
+  EXPECT_TRUE(geometry::contains(fieldDisk(1, {}), fieldDisk(0.5, at(0.4, 0))));
+  EXPECT_FALSE(geometry::contains(fieldDisk(1, {}), fieldDisk(0.5, at(0.6, 0))));
+  EXPECT_TRUE(geometry::contains(fieldSphere(1, {}), sphere(0.3, at(0.5, 0, 0))));
+  EXPECT_FALSE(geometry::contains(fieldSphere(1, {}), sphere(0.3, at(0.8, 0, 0))));
+  EXPECT_TRUE(geometry::contains(r, r)); // up to the tolerance
+  EXPECT_THROW(geometry::contains(segment({ 0, 0, 0 }, { 1, 0, 0 }), r), std::invalid_argument);
 }
 
-TEST(EngineShapes, AreasAndVolumes)
+TEST(GeometryShapes, AreasAndVolumes)
 {
-  const Shape wall = rectangle(2, 2, at(3, 0)); // x in [2, 4], y in [-1, 1]
+  const PlacedShape wall = rectangle(2, 2, at(3, 0)); // x in [2, 4], y in [-1, 1]
   // Disk at 1.5: the part beyond x = 2 is the segment of height... d = 0.5 from the centre.
-  EXPECT_NEAR(engine::intersectionMeasure(disk(1, at(1.5, 0)), wall), SegmentArea, 1e-12);
+  EXPECT_NEAR(geometry::intersectionMeasure(disk(1, at(1.5, 0)), wall), SegmentArea, 1e-12);
   EXPECT_NEAR(SegmentArea, 0.6141848493, 1e-10);
   // Disk at 2: exactly half inside.
-  EXPECT_NEAR(engine::intersectionMeasure(disk(1, at(2, 0)), wall), Pi / 2, 1e-12);
+  EXPECT_NEAR(geometry::intersectionMeasure(disk(1, at(2, 0)), wall), Pi / 2, 1e-12);
   // The same with the field disk: interval-pruned integration (relative error ~1e-6 in 2D).
-  EXPECT_NEAR(engine::intersectionMeasure(fieldDisk(1, at(1.5, 0)), wall), SegmentArea, 1e-5);
-  EXPECT_NEAR(engine::measure(fieldDisk(1, {})), Pi, Pi * 1e-5);
+  EXPECT_NEAR(geometry::intersectionMeasure(fieldDisk(1, at(1.5, 0)), wall), SegmentArea, 1e-5);
+  EXPECT_NEAR(geometry::measure(fieldDisk(1, {})), Pi, Pi * 1e-5);
   // Rectangles [-2, 2] x [-1, 1] and [1, 3] x [0, 2]: 1 x 1.
   EXPECT_NEAR(
-    engine::intersectionMeasure(rectangle(4, 2, {}), rectangle(2, 2, at(2, 1))), 1, 1e-12);
+    geometry::intersectionMeasure(rectangle(4, 2, {}), rectangle(2, 2, at(2, 1))), 1, 1e-12);
   // Lens of two unit disks 1 apart: 2 (pi / 3 - sqrt(3) / 4) = 2 pi / 3 - sqrt(3) / 2.
-  EXPECT_NEAR(engine::intersectionMeasure(disk(1, {}), disk(1, at(1, 0))),
+  EXPECT_NEAR(geometry::intersectionMeasure(disk(1, {}), disk(1, at(1, 0))),
     2 * Pi / 3 - std::sqrt(3.0) / 2, 1e-12);
   // Circular segments: from (0, -1) to (0, 1) counter-clockwise about the origin, radius 1: the
   // right half disk; from (0.5, -sqrt 0.75) to (0.5, sqrt 0.75): the cap beyond x = 0.5.
@@ -369,33 +375,33 @@ TEST(EngineShapes, AreasAndVolumes)
   seg.kind = ShapePart::Kind::CircularSegment;
   seg.radius = 1;
   seg.points = { { 0, -1, 0 }, { 0, 1, 0 } };
-  const Shape half = shapeOf("half", 2, seg);
-  EXPECT_NEAR(engine::measure(half), Pi / 2, 1e-12);
+  const PlacedShape half = shapeOf("half", 2, seg);
+  EXPECT_NEAR(geometry::measure(half), Pi / 2, 1e-12);
   EXPECT_NEAR(half.value({ 0.5, 0, 0 }), 0.5, 1e-15);
   EXPECT_LT(half.value({ -0.5, 0, 0 }), 0);
   seg.points = { { 0.5, -std::sqrt(0.75), 0 }, { 0.5, std::sqrt(0.75), 0 } };
-  const Shape cap = shapeOf("cap", 2, seg);
-  EXPECT_NEAR(engine::measure(cap), SegmentArea, 1e-12);
+  const PlacedShape cap = shapeOf("cap", 2, seg);
+  EXPECT_NEAR(geometry::measure(cap), SegmentArea, 1e-12);
   // The cap against a large rectangle covering it, and against x >= 0.75 (the cap of d = 0.75:
   // acos(0.75) - 0.75 sqrt(1 - 0.5625)).
-  EXPECT_NEAR(engine::intersectionMeasure(cap, rectangle(4, 4, {})), SegmentArea, 1e-12);
-  EXPECT_NEAR(engine::intersectionMeasure(cap, rectangle(2, 4, at(1.75, 0))),
+  EXPECT_NEAR(geometry::intersectionMeasure(cap, rectangle(4, 4, {})), SegmentArea, 1e-12);
+  EXPECT_NEAR(geometry::intersectionMeasure(cap, rectangle(2, 4, at(1.75, 0))),
     std::acos(0.75) - 0.75 * std::sqrt(1 - 0.5625), 1e-12);
   // Volumes: unit spheres 1 apart overlap in pi (2r - d)^2 (d^2 + 4 d r) / (12 d) = 5 pi / 12.
   EXPECT_NEAR(
-    engine::intersectionMeasure(sphere(1, {}), sphere(1, at(1, 0, 0))), 5 * Pi / 12, 1e-12);
-  EXPECT_NEAR(engine::measure(sphere(1, {})), 4 * Pi / 3, 1e-12);
-  EXPECT_NEAR(engine::measure(fieldSphere(1, {})), 4 * Pi / 3, 4 * Pi / 3 * 2e-4);
+    geometry::intersectionMeasure(sphere(1, {}), sphere(1, at(1, 0, 0))), 5 * Pi / 12, 1e-12);
+  EXPECT_NEAR(geometry::measure(sphere(1, {})), 4 * Pi / 3, 1e-12);
+  EXPECT_NEAR(geometry::measure(fieldSphere(1, {})), 4 * Pi / 3, 4 * Pi / 3 * 2e-4);
   // Scaled: a rectangle 1 x 1 scaled by (2, 3) has area 6.
-  EXPECT_NEAR(engine::measure(
+  EXPECT_NEAR(geometry::measure(
                 rectangle(1, 1, Affine::fromTransform({ 0, 0, 0 }, { 0, 0, 0.3 }, { 2, 3, 1 }))),
     6, 1e-12);
 }
 
-TEST(EngineShapes, ComplexCells)
+TEST(GeometryShapes, ComplexCells)
 {
   // Disk: F cell, carrier z, inside the world field.
-  const auto d = engine::toComplexCell(disk(1, at(1, 0)), complex::CellKind::FRep);
+  const auto d = geometry::toComplexCell(disk(1, at(1, 0)), complex::CellKind::FRep);
   EXPECT_NO_THROW(complex::checkCell(d));
   EXPECT_EQ(d.dimension, 2);
   const auto& g = std::get<complex::ImplicitGeometry>(d.geometry);
@@ -412,7 +418,7 @@ TEST(EngineShapes, ComplexCells)
   inside->gradient({ 2.5, 0, 0 }, grad);
   EXPECT_NEAR(grad[0], -1, 1e-6);
   // Field sphere: F cell, no carrier, the placed field.
-  const auto s = engine::toComplexCell(fieldSphere(1, at(0, 0, 2)), complex::CellKind::FRep);
+  const auto s = geometry::toComplexCell(fieldSphere(1, at(0, 0, 2)), complex::CellKind::FRep);
   EXPECT_NO_THROW(complex::checkCell(s));
   const auto& gs = std::get<complex::ImplicitGeometry>(s.geometry);
   EXPECT_TRUE(gs.carriers.empty());
@@ -421,27 +427,29 @@ TEST(EngineShapes, ComplexCells)
   ShapePart point;
   point.kind = ShapePart::Kind::Point;
   point.points = { { 1, 2, 0 } };
-  const auto p = engine::toComplexCell(shapeOf("p", 0, point, at(1, 0)), complex::CellKind::Point);
+  const auto p =
+    geometry::toComplexCell(shapeOf("p", 0, point, at(1, 0)), complex::CellKind::Point);
   EXPECT_NO_THROW(complex::checkCell(p));
   EXPECT_EQ(std::get<complex::ExplicitGeometry>(p.geometry).points[0][0], 2);
-  const auto l = engine::toComplexCell(segment({ 0, 0, 0 }, { 1, 0, 0 }), complex::CellKind::BRep);
+  const auto l =
+    geometry::toComplexCell(segment({ 0, 0, 0 }, { 1, 0, 0 }), complex::CellKind::BRep);
   EXPECT_NO_THROW(complex::checkCell(l));
   ShapePart arc;
   arc.kind = ShapePart::Kind::Arc;
   arc.radius = 1;
   arc.points = { { 1, 0, 0 }, { 0, 1, 0 } };
-  engine::QueryOptions o;
+  geometry::QueryOptions o;
   o.arcSegments = 16; // a quarter turn: 4 segments
-  const auto a = engine::toComplexCell(shapeOf("arc", 1, arc), complex::CellKind::BRep, o);
+  const auto a = geometry::toComplexCell(shapeOf("arc", 1, arc), complex::CellKind::BRep, o);
   EXPECT_NO_THROW(complex::checkCell(a));
   EXPECT_EQ(std::get<complex::ExplicitGeometry>(a.geometry).points.size(), 5u);
-  const auto r = engine::toComplexCell(rectangle(2, 1, {}), complex::CellKind::BRep);
+  const auto r = geometry::toComplexCell(rectangle(2, 1, {}), complex::CellKind::BRep);
   EXPECT_NO_THROW(complex::checkCell(r));
   EXPECT_EQ(std::get<complex::ExplicitGeometry>(r.geometry).triangles.size(), 2u);
   ShapePart box;
   box.kind = ShapePart::Kind::Box;
   box.size = { 1, 2, 3 };
-  const auto b = engine::toComplexCell(shapeOf("box", 3, box), complex::CellKind::BRep);
+  const auto b = geometry::toComplexCell(shapeOf("box", 3, box), complex::CellKind::BRep);
   EXPECT_NO_THROW(complex::checkCell(b));
   const auto& gb = std::get<complex::ExplicitGeometry>(b.geometry);
   ASSERT_EQ(gb.tetrahedra.size(), 6u);
@@ -465,14 +473,14 @@ TEST(EngineShapes, ComplexCells)
   EXPECT_NEAR(volume, 6, 1e-12);
   // A rectangle asked for as an F cell stays explicit (B): checkCell accepts it.
   EXPECT_NO_THROW(
-    complex::checkCell(engine::toComplexCell(rectangle(2, 1, {}), complex::CellKind::FRep)));
+    complex::checkCell(geometry::toComplexCell(rectangle(2, 1, {}), complex::CellKind::FRep)));
 }
 
-TEST(EngineShapes, Errors)
+TEST(GeometryShapes, Errors)
 {
   try
   {
-    engine::intersectionPoints(sphere(1, {}, "Egg"), sphere(1, at(1, 0, 0), "Shell"));
+    geometry::intersectionPoints(sphere(1, {}, "Egg"), sphere(1, at(1, 0, 0), "Shell"));
     FAIL() << "3D pair accepted";
   }
   catch (const std::invalid_argument& e)
@@ -481,40 +489,42 @@ TEST(EngineShapes, Errors)
     EXPECT_NE(std::string(e.what()).find("Shell"), std::string::npos);
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(engine::distance(disk(1, at(nan, 0)), disk(1, {})), std::invalid_argument);
-  EXPECT_THROW(engine::distance(disk(nan, {}), disk(1, {})), std::invalid_argument);
-  const Shape flat = disk(1, Affine::fromTransform({ 0, 0, 0 }, { 0, 0, 0 }, { 0, 1, 1 }), "Flat");
+  EXPECT_THROW(geometry::distance(disk(1, at(nan, 0)), disk(1, {})), std::invalid_argument);
+  EXPECT_THROW(geometry::distance(disk(nan, {}), disk(1, {})), std::invalid_argument);
+  const PlacedShape flat =
+    disk(1, Affine::fromTransform({ 0, 0, 0 }, { 0, 0, 0 }, { 0, 1, 1 }), "Flat");
   try
   {
-    engine::intersects(flat, disk(1, {}));
+    geometry::intersects(flat, disk(1, {}));
     FAIL() << "singular placement accepted";
   }
   catch (const std::invalid_argument& e)
   {
     EXPECT_NE(std::string(e.what()).find("Flat"), std::string::npos);
   }
-  EXPECT_THROW(engine::measure(segment({ 0, 0, 0 }, { 1, 0, 0 })), std::invalid_argument);
+  EXPECT_THROW(geometry::measure(segment({ 0, 0, 0 }, { 1, 0, 0 })), std::invalid_argument);
 }
 
-TEST(EngineShapes, Timings)
+TEST(GeometryShapes, Timings)
 {
   // Not a benchmark: a guard that the queries stay in their budget (microseconds for analytic
   // shapes, well below 10 ms for small fields), and the numbers for the report.
-  const Shape d = disk(1, at(1 + 1e-3, 0));
-  const Shape w = rectangle(2, 2, at(3, 0));
-  const Shape fd = fieldDisk(1, at(1 + 1e-3, 0));
-  const double pointsAnalytic = microseconds(200, [&] { engine::intersectionPoints(d, w); });
-  const double distanceAnalytic = microseconds(200, [&] { engine::distance(d, w); });
-  const double areaAnalytic = microseconds(200, [&] { engine::intersectionMeasure(d, w); });
-  const double pointsField = microseconds(20, [&] { engine::intersectionPoints(fd, w); });
-  const double intersectsField = microseconds(20, [&] { engine::intersects(fd, w); });
-  const double fieldField =
-    microseconds(5, [&] { engine::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(1, 0))); });
+  const PlacedShape d = disk(1, at(1 + 1e-3, 0));
+  const PlacedShape w = rectangle(2, 2, at(3, 0));
+  const PlacedShape fd = fieldDisk(1, at(1 + 1e-3, 0));
+  const double pointsAnalytic = microseconds(200, [&] { geometry::intersectionPoints(d, w); });
+  const double distanceAnalytic = microseconds(200, [&] { geometry::distance(d, w); });
+  const double areaAnalytic = microseconds(200, [&] { geometry::intersectionMeasure(d, w); });
+  const double pointsField = microseconds(20, [&] { geometry::intersectionPoints(fd, w); });
+  const double intersectsField = microseconds(20, [&] { geometry::intersects(fd, w); });
+  const double fieldField = microseconds(
+    5, [&] { geometry::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(1, 0))); });
   const double distanceSpheres = microseconds(20,
-    [&] { engine::distance(fieldSphere(0.5, at(-0.75, 0, 0)), fieldSphere(0.5, at(0.75, 0, 0))); });
+    [&]
+    { geometry::distance(fieldSphere(0.5, at(-0.75, 0, 0)), fieldSphere(0.5, at(0.75, 0, 0))); });
   const double containsField =
-    microseconds(5, [&] { engine::contains(fieldDisk(1, {}), fieldDisk(0.5, at(0.4, 0))); });
-  const double areaField = microseconds(5, [&] { engine::intersectionMeasure(fd, w); });
+    microseconds(5, [&] { geometry::contains(fieldDisk(1, {}), fieldDisk(0.5, at(0.4, 0))); });
+  const double areaField = microseconds(5, [&] { geometry::intersectionMeasure(fd, w); });
   std::printf("intersectionPoints disk/rectangle %.1f us, distance %.1f us, area %.1f us\n",
     pointsAnalytic, distanceAnalytic, areaAnalytic);
   std::printf("field disk/rectangle: points %.1f us, intersects %.1f us, area %.1f us\n",
@@ -528,15 +538,15 @@ TEST(EngineShapes, Timings)
 // Data/Models/icm/ch5_1_disk_rectangle.icm: DEQS = rectangle(2, 4) at (3, 0), so x in [2, 4]
 // and y in [-2, 2]; LHKF = the HyperFun disk 1 - x^2 - y^2 on the domain [-1, 1]^2, moving
 // along x. The domain clips the field exactly at the disk's box.
-TEST(EngineShapes, DiskThroughRectangleModel)
+TEST(GeometryShapes, DiskThroughRectangleModel)
 {
-  const Shape deqs = rectangle(2, 4, at(3, 0), "DEQS");
+  const PlacedShape deqs = rectangle(2, 4, at(3, 0), "DEQS");
   for (bool field : { false, true })
   {
     SCOPED_TRACE(field ? "HyperFun disk" : "analytic disk");
     auto lhkf = [&](double c)
     {
-      Shape s = field ? fieldDisk(1, at(c, 0), "LHKF") : disk(1, at(c, 0), "LHKF");
+      PlacedShape s = field ? fieldDisk(1, at(c, 0), "LHKF") : disk(1, at(c, 0), "LHKF");
       if (field)
       {
         s.parts[0].bounds = { { -1, -1, 0 }, { 1, 1, 0 } };
@@ -545,30 +555,30 @@ TEST(EngineShapes, DiskThroughRectangleModel)
     };
     const double distanceTol = field ? 1e-6 : 1e-12;
     // Centre 0.5: the gap to x = 2 is 2 - 1.5.
-    EXPECT_NEAR(engine::distance(lhkf(0.5), deqs), 0.5, distanceTol);
-    EXPECT_FALSE(engine::intersects(lhkf(0.5), deqs));
-    EXPECT_EQ(engine::intersectionPoints(lhkf(0.5), deqs).size(), 0u);
+    EXPECT_NEAR(geometry::distance(lhkf(0.5), deqs), 0.5, distanceTol);
+    EXPECT_FALSE(geometry::intersects(lhkf(0.5), deqs));
+    EXPECT_EQ(geometry::intersectionPoints(lhkf(0.5), deqs).size(), 0u);
     // Centre 1: touching at (2, 0).
-    auto touch = engine::intersectionPoints(lhkf(1), deqs);
+    auto touch = geometry::intersectionPoints(lhkf(1), deqs);
     ASSERT_EQ(touch.size(), 1u);
     expectPoint(touch[0], 2, 0, 1e-7);
-    EXPECT_NEAR(engine::distance(lhkf(1), deqs), 0, distanceTol);
+    EXPECT_NEAR(geometry::distance(lhkf(1), deqs), 0, distanceTol);
     // Centre 2: the centre on the side x = 2; the circle crosses it at (2, +-1); half inside.
-    auto half = engine::intersectionPoints(lhkf(2), deqs);
+    auto half = geometry::intersectionPoints(lhkf(2), deqs);
     ASSERT_EQ(half.size(), 2u);
     expectPoint(half[0], 2, -1, 1e-9);
     expectPoint(half[1], 2, 1, 1e-9);
     // The field disk's domain [-1, 1]^2 clips it along its own box: kinks cost accuracy.
-    EXPECT_NEAR(engine::intersectionMeasure(lhkf(2), deqs), Pi / 2, field ? 1e-4 : 1e-12);
+    EXPECT_NEAR(geometry::intersectionMeasure(lhkf(2), deqs), Pi / 2, field ? 1e-4 : 1e-12);
     // Centre 3: inside, touching both sides x = 2 and x = 4.
-    auto inside = engine::intersectionPoints(lhkf(3), deqs);
+    auto inside = geometry::intersectionPoints(lhkf(3), deqs);
     ASSERT_EQ(inside.size(), 2u);
     expectPoint(inside[0], 2, 0, 1e-7);
     expectPoint(inside[1], 4, 0, 1e-7);
-    EXPECT_TRUE(engine::contains(deqs, lhkf(3)));
-    EXPECT_FALSE(engine::contains(deqs, lhkf(3.1)));
+    EXPECT_TRUE(geometry::contains(deqs, lhkf(3)));
+    EXPECT_FALSE(geometry::contains(deqs, lhkf(3.1)));
     // Centre 3.5: crossing x = 4 at (4, +-sqrt(1 - 0.25)).
-    auto out = engine::intersectionPoints(lhkf(3.5), deqs);
+    auto out = geometry::intersectionPoints(lhkf(3.5), deqs);
     ASSERT_EQ(out.size(), 2u);
     expectPoint(out[0], 4, -std::sqrt(0.75), 1e-9);
     expectPoint(out[1], 4, std::sqrt(0.75), 1e-9);
@@ -578,7 +588,7 @@ TEST(EngineShapes, DiskThroughRectangleModel)
 // Data/Models/icm/andyhausen.icm: the egg shell (an ellipsoid 0.5 x 0.7 x 0.5, HyperFun
 // 1 - (x/0.5)^2 - (y/0.7)^2 - (z/0.5)^2) above the liquid (-3.2 - y) & (4 - x^2 - z^2) on
 // [-2, 2] x [-5, -3.2] x [-2, 2].
-TEST(EngineShapes, EggAndLiquidModel)
+TEST(GeometryShapes, EggAndLiquidModel)
 {
   using frep::Expr;
   const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
@@ -590,29 +600,29 @@ TEST(EngineShapes, EggAndLiquidModel)
   liquid.kind = ShapePart::Kind::Field;
   liquid.field = fieldOf(min(-3.2 - y, 4 - x * x - z * z));
   liquid.bounds = { { -2, -5, -2 }, { 2, -3.2, 2 } };
-  const Shape pool = shapeOf("Liquid", 3, liquid);
+  const PlacedShape pool = shapeOf("Liquid", 3, liquid);
   auto egg = [&](double height)
   {
     return shapeOf("Eggshell", 3, shell, at(0, height, 0));
   };
   // Centre at -2: the bottom -2.7 is 0.5 above the surface -3.2.
-  EXPECT_NEAR(engine::distance(pool, egg(-2)), 0.5, 1e-6);
-  EXPECT_FALSE(engine::intersects(pool, egg(-2)));
-  EXPECT_TRUE(engine::intersects(pool, egg(-2.6)));
-  EXPECT_TRUE(engine::intersects(pool, egg(-2.5))); // touching
-  EXPECT_FALSE(engine::contains(pool, egg(-3)));
-  EXPECT_TRUE(engine::contains(pool, egg(-4))); // y in [-4.7, -3.3]
+  EXPECT_NEAR(geometry::distance(pool, egg(-2)), 0.5, 1e-6);
+  EXPECT_FALSE(geometry::intersects(pool, egg(-2)));
+  EXPECT_TRUE(geometry::intersects(pool, egg(-2.6)));
+  EXPECT_TRUE(geometry::intersects(pool, egg(-2.5))); // touching
+  EXPECT_FALSE(geometry::contains(pool, egg(-3)));
+  EXPECT_TRUE(geometry::contains(pool, egg(-4))); // y in [-4.7, -3.3]
   // Half submerged at -3.2: half the ellipsoid's 4/3 pi 0.5 0.7 0.5.
-  EXPECT_NEAR(engine::intersectionMeasure(pool, egg(-3.2)), 2.0 / 3 * Pi * 0.5 * 0.7 * 0.5,
+  EXPECT_NEAR(geometry::intersectionMeasure(pool, egg(-3.2)), 2.0 / 3 * Pi * 0.5 * 0.7 * 0.5,
     2e-4 * Pi * 0.5 * 0.7 * 0.5);
-  const double volume = microseconds(1, [&] { engine::intersectionMeasure(pool, egg(-3.2)); });
+  const double volume = microseconds(1, [&] { geometry::intersectionMeasure(pool, egg(-3.2)); });
   std::printf("egg/liquid volume %.1f us\n", volume);
   const double t = microseconds(5,
     [&]
     {
-      engine::distance(pool, egg(-2));
-      engine::intersects(pool, egg(-2));
-      engine::contains(pool, egg(-4));
+      geometry::distance(pool, egg(-2));
+      geometry::intersects(pool, egg(-2));
+      geometry::contains(pool, egg(-4));
     });
   std::printf("egg/liquid distance + intersects + contains %.1f us\n", t);
 }
@@ -620,9 +630,9 @@ TEST(EngineShapes, EggAndLiquidModel)
 // The disk of DiskThroughRectangleModel swept in steps of 0.01: the count of meeting points is
 // 0 before x = 1, 2 while the circle crosses a side (1 < c < 3 and 3 < c < 5) and 0 after 5,
 // for the analytic and the HyperFun disk alike.
-TEST(EngineShapes, SweptDiskCounts)
+TEST(GeometryShapes, SweptDiskCounts)
 {
-  const Shape deqs = rectangle(2, 4, at(3, 0), "DEQS");
+  const PlacedShape deqs = rectangle(2, 4, at(3, 0), "DEQS");
   for (int k = -50; k <= 550; ++k)
   {
     const double c = 0.01 * k;
@@ -635,50 +645,50 @@ TEST(EngineShapes, SweptDiskCounts)
     {
       expected = 2;
     }
-    const Shape a = disk(1, at(c, 0));
-    const Shape f = fieldDisk(1, at(c, 0));
-    EXPECT_EQ(engine::intersectionPoints(a, deqs).size(), expected) << "c = " << c;
-    EXPECT_EQ(engine::intersectionPoints(f, deqs).size(), expected) << "field, c = " << c;
-    EXPECT_EQ(engine::intersects(a, deqs), c > 1 - 1e-9 && c < 5 + 1e-9) << "c = " << c;
-    EXPECT_EQ(engine::intersects(f, deqs), c > 1 - 1e-9 && c < 5 + 1e-9) << "field, c = " << c;
+    const PlacedShape a = disk(1, at(c, 0));
+    const PlacedShape f = fieldDisk(1, at(c, 0));
+    EXPECT_EQ(geometry::intersectionPoints(a, deqs).size(), expected) << "c = " << c;
+    EXPECT_EQ(geometry::intersectionPoints(f, deqs).size(), expected) << "field, c = " << c;
+    EXPECT_EQ(geometry::intersects(a, deqs), c > 1 - 1e-9 && c < 5 + 1e-9) << "c = " << c;
+    EXPECT_EQ(geometry::intersects(f, deqs), c > 1 - 1e-9 && c < 5 + 1e-9) << "field, c = " << c;
   }
 }
 
-TEST(EngineShapes, FieldFieldTangency)
+TEST(GeometryShapes, FieldFieldTangency)
 {
   // Field disks of radius 1 with centres 2 apart touch at (1, 0); 2.001 apart they do not.
-  auto touch = engine::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(2, 0)));
+  auto touch = geometry::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(2, 0)));
   ASSERT_EQ(touch.size(), 1u);
   expectPoint(touch[0], 1, 0, 1e-4);
-  EXPECT_EQ(engine::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(2.001, 0))).size(), 0u);
-  EXPECT_TRUE(engine::intersects(fieldDisk(1, {}), fieldDisk(1, at(2, 0))));
-  EXPECT_FALSE(engine::intersects(fieldDisk(1, {}), fieldDisk(1, at(2.001, 0))));
+  EXPECT_EQ(geometry::intersectionPoints(fieldDisk(1, {}), fieldDisk(1, at(2.001, 0))).size(), 0u);
+  EXPECT_TRUE(geometry::intersects(fieldDisk(1, {}), fieldDisk(1, at(2, 0))));
+  EXPECT_FALSE(geometry::intersects(fieldDisk(1, {}), fieldDisk(1, at(2.001, 0))));
 }
 
-TEST(EngineShapes, PointsPolylinesAndMoreCells)
+TEST(GeometryShapes, PointsPolylinesAndMoreCells)
 {
-  const Shape r = rectangle(4, 2, {});
+  const PlacedShape r = rectangle(4, 2, {});
   ShapePart point;
   point.kind = ShapePart::Kind::Point;
   point.points = { { 2, 0.5, 0 } }; // on the side x = 2
-  const Shape onSide = shapeOf("P", 0, point);
-  auto p = engine::intersectionPoints(onSide, r);
+  const PlacedShape onSide = shapeOf("P", 0, point);
+  auto p = geometry::intersectionPoints(onSide, r);
   ASSERT_EQ(p.size(), 1u);
   expectPoint(p[0], 2, 0.5, 0);
-  EXPECT_TRUE(engine::contains(r, onSide)); // the boundary belongs to the region
-  EXPECT_TRUE(engine::intersects(onSide, r));
-  EXPECT_EQ(engine::intersectionPoints(shapeOf("P", 0, point, at(-1, 0)), r).size(), 0u);
-  EXPECT_NEAR(engine::distance(shapeOf("P", 0, point, at(1, 0)), r), 1, 1e-15);
+  EXPECT_TRUE(geometry::contains(r, onSide)); // the boundary belongs to the region
+  EXPECT_TRUE(geometry::intersects(onSide, r));
+  EXPECT_EQ(geometry::intersectionPoints(shapeOf("P", 0, point, at(-1, 0)), r).size(), 0u);
+  EXPECT_NEAR(geometry::distance(shapeOf("P", 0, point, at(1, 0)), r), 1, 1e-15);
   // A polyline (0, 0) -> (3, 0) -> (3, 3) against the unit disk at (3, 3): it enters at
   // (3, 2) only; against the disk at (1.5, 0): (0.5, 0) and (2.5, 0).
   ShapePart line;
   line.kind = ShapePart::Kind::Polyline;
   line.points = { { 0, 0, 0 }, { 3, 0, 0 }, { 3, 3, 0 } };
-  const Shape poly = shapeOf("poly", 1, line);
-  auto a = engine::intersectionPoints(poly, disk(1, at(3, 3)));
+  const PlacedShape poly = shapeOf("poly", 1, line);
+  auto a = geometry::intersectionPoints(poly, disk(1, at(3, 3)));
   ASSERT_EQ(a.size(), 1u);
   expectPoint(a[0], 3, 2, 1e-12);
-  auto b = engine::intersectionPoints(poly, disk(1, at(1.5, 0)));
+  auto b = geometry::intersectionPoints(poly, disk(1, at(1.5, 0)));
   ASSERT_EQ(b.size(), 2u);
   expectPoint(b[0], 0.5, 0, 1e-12);
   expectPoint(b[1], 2.5, 0, 1e-12);
@@ -687,38 +697,39 @@ TEST(EngineShapes, PointsPolylinesAndMoreCells)
   arc.kind = ShapePart::Kind::Arc;
   arc.radius = 2;
   arc.points = { { 1, 0, 0 }, { 0, 1, 0 } };
-  EXPECT_TRUE(engine::contains(rectangle(8, 8, {}), shapeOf("arc", 1, arc)));
-  EXPECT_FALSE(engine::contains(rectangle(2, 2, {}), shapeOf("arc", 1, arc)));
+  EXPECT_TRUE(geometry::contains(rectangle(8, 8, {}), shapeOf("arc", 1, arc)));
+  EXPECT_FALSE(geometry::contains(rectangle(2, 2, {}), shapeOf("arc", 1, arc)));
   // Its distance to the point (3, 3): 3 sqrt 2 - 2.
   ShapePart far;
   far.kind = ShapePart::Kind::Point;
   far.points = { { 3, 3, 0 } };
-  EXPECT_NEAR(
-    engine::distance(shapeOf("arc", 1, arc), shapeOf("Q", 0, far)), 3 * std::sqrt(2.0) - 2, 1e-12);
+  EXPECT_NEAR(geometry::distance(shapeOf("arc", 1, arc), shapeOf("Q", 0, far)),
+    3 * std::sqrt(2.0) - 2, 1e-12);
   // Cells of the remaining kinds are implicit and pass checkCell.
   ShapePart seg;
   seg.kind = ShapePart::Kind::CircularSegment;
   seg.radius = 1;
   seg.points = { { 0, -1, 0 }, { 0, 1, 0 } };
-  const auto cs = engine::toComplexCell(shapeOf("half", 2, seg, at(1, 0)), complex::CellKind::FRep);
+  const auto cs =
+    geometry::toComplexCell(shapeOf("half", 2, seg, at(1, 0)), complex::CellKind::FRep);
   EXPECT_NO_THROW(complex::checkCell(cs));
   // The right half disk at (1, 0): at (1.5, 0) the chord is 0.5 away, the circle 0.5.
   EXPECT_NEAR(
     std::get<complex::ImplicitGeometry>(cs.geometry).inside[0]->evaluator()->value({ 1.5, 0, 0 }),
     0.5, 1e-15);
-  auto A = std::make_shared<Shape>(disk(1, at(-1.5, 0), "a"));
-  auto B = std::make_shared<Shape>(disk(1, at(1.5, 0), "b"));
+  auto A = std::make_shared<PlacedShape>(disk(1, at(-1.5, 0), "a"));
+  auto B = std::make_shared<PlacedShape>(disk(1, at(1.5, 0), "b"));
   ShapePart blend;
   blend.kind = ShapePart::Kind::Blend;
   blend.operandA = A;
   blend.operandB = B;
   blend.amount = 0.5;
-  const auto bc = engine::toComplexCell(shapeOf("blend", 2, blend), complex::CellKind::Composite);
+  const auto bc = geometry::toComplexCell(shapeOf("blend", 2, blend), complex::CellKind::Composite);
   EXPECT_NO_THROW(complex::checkCell(bc));
   EXPECT_NEAR(
     std::get<complex::ImplicitGeometry>(bc.geometry).inside[0]->evaluator()->value({ 0, 0, 0 }),
     -1 + std::sqrt(0.5) + 0.5 / 1.5, 1e-15);
-  const auto sc = engine::toComplexCell(sphere(2, at(0, 0, 1)), complex::CellKind::FRep);
+  const auto sc = geometry::toComplexCell(sphere(2, at(0, 0, 1)), complex::CellKind::FRep);
   EXPECT_NO_THROW(complex::checkCell(sc));
   EXPECT_EQ(sc.dimension, 3);
   EXPECT_NEAR(
@@ -729,7 +740,7 @@ TEST(EngineShapes, PointsPolylinesAndMoreCells)
   ShapePart axis;
   axis.kind = ShapePart::Kind::Segment;
   axis.points = { { -5, 0, 0 }, { 5, 0, 0 } };
-  auto hits = engine::intersectionPoints(shapeOf("blend", 2, blend), shapeOf("axis", 1, axis));
+  auto hits = geometry::intersectionPoints(shapeOf("blend", 2, blend), shapeOf("axis", 1, axis));
   ASSERT_EQ(hits.size(), 2u);
   for (const auto& h : hits)
   {
@@ -746,15 +757,15 @@ TEST(EngineShapes, PointsPolylinesAndMoreCells)
 // intersects == (distance <= tolerance), and intersects iff there are meeting points or one
 // shape holds the other; otherwise a model whose instances are `!intersects` and
 // `intersectionCount == 1` has no valid instance at some time.
-TEST(EngineShapes, TouchingIsOneCriterion)
+TEST(GeometryShapes, TouchingIsOneCriterion)
 {
-  const Shape deqs = rectangle(4, 2, {}, "DEQS");
+  const PlacedShape deqs = rectangle(4, 2, {}, "DEQS");
   int touching = 0;
   double worst = 0;
   for (int k = 0; k <= 2000; ++k)
   {
     const double c = 1.5 - 1e-6 + k * 1e-9;
-    Shape lhkf = fieldDisk(0.5, at(1, c), "LHKF");
+    PlacedShape lhkf = fieldDisk(0.5, at(1, c), "LHKF");
     lhkf.parts[0].bounds = { { -0.5, -0.5, 0 }, { 0.5, 0.5, 0 } };
     const auto joint = deqs.worldBounds();
     const auto box = lhkf.worldBounds();
@@ -762,10 +773,10 @@ TEST(EngineShapes, TouchingIsOneCriterion)
     const double dy = std::max(joint.hi[1], box.hi[1]) - std::min(joint.lo[1], box.lo[1]);
     const double dz = std::max(joint.hi[2], box.hi[2]) - std::min(joint.lo[2], box.lo[2]);
     const double tol = 1e-9 * std::sqrt(dx * dx + dy * dy + dz * dz);
-    const double d = engine::distance(deqs, lhkf);
-    const bool meets = engine::intersects(deqs, lhkf);
-    const auto points = engine::intersectionPoints(deqs, lhkf);
-    const bool inside = engine::contains(deqs, lhkf) || engine::contains(lhkf, deqs);
+    const double d = geometry::distance(deqs, lhkf);
+    const bool meets = geometry::intersects(deqs, lhkf);
+    const auto points = geometry::intersectionPoints(deqs, lhkf);
+    const bool inside = geometry::contains(deqs, lhkf) || geometry::contains(lhkf, deqs);
     ASSERT_EQ(meets, d <= tol) << "c = " << c << ", distance " << d;
     ASSERT_EQ(meets, !points.empty() || inside) << "c = " << c << ", distance " << d;
     // The gap is c - 0.5 - 1 above the edge.
@@ -793,16 +804,16 @@ TEST(EngineShapes, TouchingIsOneCriterion)
   for (int k = -20; k <= 20; ++k)
   {
     const double gap = k * 1e-9;
-    const Shape e = shapeOf(
+    const PlacedShape e = shapeOf(
       "E", 2, ellipse, Affine::fromTransform({ 1, 1 + drop + gap, 0 }, { 0, 0, 0.5 }, { 1, 1, 1 }));
     const auto joint = deqs.worldBounds();
     const auto box = e.worldBounds();
     const double dx = std::max(joint.hi[0], box.hi[0]) - std::min(joint.lo[0], box.lo[0]);
     const double dy = std::max(joint.hi[1], box.hi[1]) - std::min(joint.lo[1], box.lo[1]);
     const double tol = 1e-9 * std::hypot(dx, dy);
-    const double d = engine::distance(deqs, e);
-    const bool meets = engine::intersects(deqs, e);
-    const auto points = engine::intersectionPoints(deqs, e);
+    const double d = geometry::distance(deqs, e);
+    const bool meets = geometry::intersects(deqs, e);
+    const auto points = geometry::intersectionPoints(deqs, e);
     EXPECT_NEAR(d, std::max(gap, 0.0), 1e-12) << "gap " << gap;
     ASSERT_EQ(meets, d <= tol) << "gap " << gap << ", distance " << d;
     ASSERT_EQ(meets, !points.empty()) << "gap " << gap << ", distance " << d;
@@ -812,7 +823,7 @@ TEST(EngineShapes, TouchingIsOneCriterion)
 // The egg of Data/Models/icm/andyhausen.icm, eroded by a (1 - ... - 0.2 a), sinking into the
 // liquid: the liquid holds it exactly when its top c + 0.7 sqrt(1 - 0.2 a) is at or below the
 // surface -3.2. The flip is found by bisection on the centre height c.
-TEST(EngineShapes, ContainsFlipsAtTheExactPlacement)
+TEST(GeometryShapes, ContainsFlipsAtTheExactPlacement)
 {
   using frep::Expr;
   const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
@@ -820,7 +831,7 @@ TEST(EngineShapes, ContainsFlipsAtTheExactPlacement)
   liquid.kind = ShapePart::Kind::Field;
   liquid.field = fieldOf(min(-3.2 - y, 4 - x * x - z * z));
   liquid.bounds = { { -2, -5, -2 }, { 2, -3.2, 2 } };
-  const Shape pool = shapeOf("Liquid", 3, liquid);
+  const PlacedShape pool = shapeOf("Liquid", 3, liquid);
   for (double a : { 0.0, 0.8 })
   {
     SCOPED_TRACE(a);
@@ -834,12 +845,12 @@ TEST(EngineShapes, ContainsFlipsAtTheExactPlacement)
     };
     const double exact = -3.2 - 0.7 * std::sqrt(1 - 0.2 * a);
     double lo = exact - 0.05, hi = exact + 0.05; // contained at lo, not at hi
-    ASSERT_TRUE(engine::contains(pool, egg(lo)));
-    ASSERT_FALSE(engine::contains(pool, egg(hi)));
+    ASSERT_TRUE(geometry::contains(pool, egg(lo)));
+    ASSERT_FALSE(geometry::contains(pool, egg(hi)));
     while (hi - lo > 1e-13)
     {
       const double mid = 0.5 * (lo + hi);
-      (engine::contains(pool, egg(mid)) ? lo : hi) = mid;
+      (geometry::contains(pool, egg(mid)) ? lo : hi) = mid;
     }
     // "Up to the tolerance" means min fA over B >= -tol: the top may rise tol above the surface
     // (the tolerance is 1e-9 x the joint diagonal, the liquid's box and the egg's).
@@ -856,8 +867,8 @@ TEST(EngineShapes, ContainsFlipsAtTheExactPlacement)
       exact, lo - exact, tol, lo - exact - tol);
     EXPECT_NEAR(lo - exact, tol, 1e-12);
     EXPECT_NEAR(lo, exact, 1e-6);
-    const double us = microseconds(20, [&] { engine::contains(pool, egg(exact - 1e-7)); });
-    const double usOut = microseconds(20, [&] { engine::contains(pool, egg(exact + 1e-7)); });
+    const double us = microseconds(20, [&] { geometry::contains(pool, egg(exact - 1e-7)); });
+    const double usOut = microseconds(20, [&] { geometry::contains(pool, egg(exact + 1e-7)); });
     std::printf("contains near the flip: %.1f us (inside), %.1f us (outside)\n", us, usOut);
     EXPECT_LT(us, 1000);
     EXPECT_LT(usOut, 1000);

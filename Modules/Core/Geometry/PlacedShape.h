@@ -1,31 +1,30 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// The shapes of a running model's cells, placed in the world, and the geometric queries of the
-// reaction library (docs/icm.md: distance, intersects, contains, intersectionCount,
-// intersectionPoint, intersectionArea).
+// Shapes placed in the world: the shapes of a running model's cells, which the geometric queries
+// of Queries.h (the reaction library's, docs/icm.md) and the conversion to complex cells
+// (ShapeCells.h) work on.
 //
 // A cell's shape is one or more parts given in the cell's local coordinates (a rectangle, a disk,
 // a box, a HyperFun field, a segment...), placed by an affine map (the cell's translation,
 // rotation and scale, composed with its parents' under HIERARCHICAL dependencies). A 2D model
 // (cells of `dim = 2D` or less whose fields are functions of x[2]) lies in the plane z = 0.
 //
-// Queries are exact for the analytic parts (polygons, circles, segments, arcs) and, for fields,
-// located to `QueryOptions::tolerance` by Newton steps on the field and interval arithmetic
-// (frep::Field) where a proof is needed (intersects, contains). Everything is deterministic: no
-// random sampling, no threads.
+// The engine (Engine/DynamicModel) builds a cell's placed shape at an instant; its field
+// (PlacedShape::value, worldField) is >= 0 inside, as every FRep field.
 
-#include "Complex/Cell.h"
 #include "FRep/Field.h"
+#include "FRep/Vector.h"
 
 #include <array>
 #include <memory>
 #include <string>
 #include <vector>
 
-namespace ictk::engine
+namespace ictk::geometry
 {
 
-using Vec3 = std::array<double, 3>;
+/// A point or vector of the world: the kernel's (FRep/Vector.h).
+using Vec3 = frep::Point3;
 
 /// x -> A x + b.
 struct Affine
@@ -46,8 +45,8 @@ struct Affine
   bool isIdentity() const;
 };
 
-struct Shape;
-using ShapePtr = std::shared_ptr<const Shape>;
+struct PlacedShape;
+using PlacedShapePtr = std::shared_ptr<const PlacedShape>;
 
 /// One part of a shape, in the cell's local coordinates.
 struct ShapePart
@@ -77,12 +76,12 @@ struct ShapePart
   frep::Box3 bounds; ///< Field: the cell's domain (local coordinates)
   /// Blend / Union: the operands, already placed in the world; Blend's `amount` >= 0 is the
   /// blending strength (0 = the plain union, max(f1, f2)).
-  ShapePtr operandA, operandB;
+  PlacedShapePtr operandA, operandB;
   double amount = 0.0;
 };
 
 /// A cell's shape placed in the world.
-struct Shape
+struct PlacedShape
 {
   std::string cell;             ///< the cell's name, for error messages
   int dimension = 3;            ///< the cell's declared dimension (0..3)
@@ -105,31 +104,9 @@ struct QueryOptions
   int arcSegments = 256;
 };
 
-/// The distance between the two point sets (0 when they intersect).
-double distance(const Shape& a, const Shape& b, const QueryOptions& o = {});
-/// Whether they share a point (distance <= tolerance).
-bool intersects(const Shape& a, const Shape& b, const QueryOptions& o = {});
-/// Whether b lies inside a (a must be 2D or 3D; up to tolerance).
-bool contains(const Shape& a, const Shape& b, const QueryOptions& o = {});
-/// The isolated points where the boundaries of two shapes in the plane meet: boundary curve of a
-/// 2D shape or the curve of a 1D shape, against the same of the other. Points closer than the
-/// tolerance are one point (a tangency counts once). Sorted by x, then y, then z (deterministic).
-/// Throws std::invalid_argument naming the cells for pairs that do not meet in points (3D
-/// shapes).
-std::vector<Vec3> intersectionPoints(const Shape& a, const Shape& b, const QueryOptions& o = {});
-/// The area (2D pairs) or volume (3D pairs) of the intersection of two 2D or 3D shapes.
-double intersectionMeasure(const Shape& a, const Shape& b, const QueryOptions& o = {});
-/// The area (2D) or volume (3D) of a shape.
-double measure(const Shape& s, const QueryOptions& o = {});
+/// The world-space field of a 2D or 3D shape (>= 0 inside; the value PlacedShape::value gives),
+/// with interval bounds and gradients, as a frep::Field (the inside field of toComplexCell's
+/// cells).
+frep::FieldPtr worldField(const PlacedShape& s);
 
-/// The world-space field of a 2D or 3D shape (>= 0 inside; the value Shape::value gives), with
-/// interval bounds and gradients, as a frep::Field (the inside field of toComplexCell's cells).
-frep::FieldPtr worldField(const Shape& s);
-
-/// The cell of an implicit complex that the placed shape stands for at this instant: implicit
-/// geometry for fields, disks, spheres, sectors, blends and unions (2D ones carried by z = 0);
-/// explicit points, polylines (arcs sampled with QueryOptions::arcSegments), triangles
-/// (rectangles) or tetrahedra (boxes). `kind` and the name/dimension are copied to the cell.
-complex::Cell toComplexCell(const Shape& s, complex::CellKind kind, const QueryOptions& o = {});
-
-} // namespace ictk::engine
+} // namespace ictk::geometry

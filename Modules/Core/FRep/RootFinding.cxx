@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "Dynamics/RootFinding.h"
+#include "FRep/RootFinding.h"
 
 #include <cmath>
 #include <stdexcept>
 #include <vector>
 
-namespace ictk::dyn
+namespace ictk::frep
 {
 
 namespace
@@ -180,4 +180,4 @@ std::optional<Crossing> locateCrossing(
   return std::nullopt;
 }
 
-} // namespace ictk::dyn
+} // namespace ictk::frep

@@ -1,0 +1,658 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The prepared shape of Prepared.h: its world pieces, field, enclosure and gradient.
+//
+// - A shape is prepared per query (Prepared): the inverse placement, one field evaluator per
+//   Field part, and the world "pieces" of its analytic parts: points, segments and arcs of
+//   ellipses (the image of a circle under the placement; a circle when the placement is a
+//   similarity in the plane). 0D/1D shapes are their pieces; rectangles, disks and circular
+//   segments are bounded by theirs.
+//
+// Its enclosures (bound) are interval arithmetic through the placement: the tape fields' own
+// interval evaluators for Field parts, the helpers of Prepared.h for the analytic parts.
+#include "Geometry/Prepared.h"
+
+#include "FRep/Vector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <stdexcept>
+#include <utility>
+
+namespace ictk::geometry::detail
+{
+namespace
+{
+
+// Pasko's blending union, f1 + f2 + sqrt(f1^2 + f2^2) + a0 / (1 + f1^2 + f2^2) (a1 = a2 = 1):
+// an R-function union (its sign is the sign of max(f1, f2)) plus a bump of height a0 where both
+// fields are near 0, which fills the crease between the operands.
+double blendUnion(double f1, double f2, double a0)
+{
+  if (a0 <= 0)
+  {
+    return std::max(f1, f2);
+  }
+  return f1 + f2 + std::hypot(f1, f2) + a0 / (1 + f1 * f1 + f2 * f2);
+}
+// The R-function part is nondecreasing in each argument; the bump is bounded by the ranges of
+// f1^2 + f2^2.
+Interval blendUnion(Interval f1, Interval f2, double a0)
+{
+  if (a0 <= 0)
+  {
+    return ivMax(f1, f2);
+  }
+  if (!std::isfinite(f1.lo) || !std::isfinite(f1.hi) || !std::isfinite(f2.lo) ||
+    !std::isfinite(f2.hi))
+  {
+    return iv(std::isfinite(f1.lo) && std::isfinite(f2.lo) ? std::max(f1.lo, f2.lo) : -Inf, Inf);
+  }
+  const Interval s1 = ivSquare(f1), s2 = ivSquare(f2);
+  const double lo = f1.lo + f2.lo + std::hypot(f1.lo, f2.lo) + a0 / (1 + s1.hi + s2.hi);
+  const double hi = f1.hi + f2.hi + std::hypot(f1.hi, f2.hi) + a0 / (1 + s1.lo + s2.lo);
+  return iv(lo, hi);
+}
+
+} // namespace
+
+double boxDiagonal(const Box3& b)
+{
+  return frep::norm(frep::sub(b.hi, b.lo));
+}
+
+Box3 joinBoxes(const Box3& a, const Box3& b)
+{
+  Box3 r;
+  for (int i = 0; i < 3; ++i)
+  {
+    r.lo[i] = std::min(a.lo[i], b.lo[i]);
+    r.hi[i] = std::max(a.hi[i], b.hi[i]);
+  }
+  return r;
+}
+
+Box3 meetBoxes(const Box3& a, const Box3& b)
+{
+  Box3 r;
+  for (int i = 0; i < 3; ++i)
+  {
+    r.lo[i] = std::max(a.lo[i], b.lo[i]);
+    r.hi[i] = std::min(a.hi[i], b.hi[i]);
+  }
+  return r;
+}
+
+Prepared::Prepared(const PlacedShape& s)
+  : shape(&s)
+{
+  dim = shapeDimension(s);
+  flat = dim <= 2;
+  Affine inverse;
+  try
+  {
+    inverse = s.place.inverse();
+  }
+  catch (const std::invalid_argument&)
+  {
+    fail(s, "its placement is singular (a zero scale?)");
+  }
+  for (const auto& part : s.parts)
+  {
+    PreparedPart pp;
+    pp.part = &part;
+    pp.dim = partDimension(part);
+    pp.toLocal = inverse;
+    switch (part.kind)
+    {
+      case ShapePart::Kind::Field:
+        pp.eval = part.field->evaluator();
+        pp.domain = fieldDomain(part);
+        analytic = false;
+        break;
+      case ShapePart::Kind::Blend:
+      case ShapePart::Kind::Union:
+        pp.a = std::make_unique<Prepared>(*part.operandA);
+        pp.b = std::make_unique<Prepared>(*part.operandB);
+        analytic = false;
+        break;
+      case ShapePart::Kind::Box:
+      case ShapePart::Kind::Sphere:
+        analytic = false;
+        break;
+      default:
+        break;
+    }
+    if (part.kind == ShapePart::Kind::CircularSegment)
+    {
+      // The chord runs from the arc's end q to its start p; the region is on its left.
+      const double a0 = std::atan2(part.points[0][1], part.points[0][0]);
+      const double a1 = std::atan2(part.points[1][1], part.points[1][0]);
+      const V2 p{ part.radius * std::cos(a0), part.radius * std::sin(a0) };
+      const V2 q{ part.radius * std::cos(a1), part.radius * std::sin(a1) };
+      const V2 e = p - q;
+      const double len = norm(e);
+      if (len == 0)
+      {
+        pp.hx = pp.hy = 0;
+        pp.hd = -Inf; // a full disk
+      }
+      else
+      {
+        pp.hx = -e.y / len;
+        pp.hy = e.x / len;
+        pp.hd = pp.hx * q.x + pp.hy * q.y;
+      }
+    }
+    parts.push_back(std::move(pp));
+    addPieces(part);
+  }
+  bounds = s.worldBounds();
+  scale = std::max(boxDiagonal(bounds), 1e-300);
+}
+
+V2 Prepared::world2(double x, double y) const
+{
+  return xy(shape->place.apply({ x, y, 0 }));
+}
+
+void Prepared::addPieces(const ShapePart& part)
+{
+  const Affine& m = shape->place;
+  auto arc = [&](double r, double t0, double t1)
+  {
+    const V2 c = world2(0, 0);
+    const V2 u = xy(m.applyLinear({ r, 0, 0 }));
+    const V2 v = xy(m.applyLinear({ 0, r, 0 }));
+    pieces.push_back(makeEllipse(c, u, v, t0, t1));
+  };
+  auto arcAngles = [&](double& t0, double& t1)
+  {
+    t0 = std::atan2(part.points[0][1], part.points[0][0]);
+    t1 = std::atan2(part.points[1][1], part.points[1][0]);
+    while (t1 <= t0)
+    {
+      t1 += 2 * Pi;
+    }
+  };
+  switch (part.kind)
+  {
+    case ShapePart::Kind::Point:
+      for (const auto& p : part.points)
+      {
+        Piece pt;
+        pt.p = xy(m.apply(p));
+        pieces.push_back(pt);
+      }
+      break;
+    case ShapePart::Kind::Segment:
+    case ShapePart::Kind::Polyline:
+      for (std::size_t i = 0; i + 1 < part.points.size(); ++i)
+      {
+        pieces.push_back(makeSegment(xy(m.apply(part.points[i])), xy(m.apply(part.points[i + 1]))));
+      }
+      break;
+    case ShapePart::Kind::Arc:
+    {
+      double t0, t1;
+      arcAngles(t0, t1);
+      arc(part.radius, t0, t1);
+      break;
+    }
+    case ShapePart::Kind::CircularSegment:
+    {
+      double t0, t1;
+      arcAngles(t0, t1);
+      arc(part.radius, t0, t1);
+      const Piece& e = pieces.back();
+      if (t1 - t0 < 2 * Pi)
+      {
+        pieces.push_back(makeSegment(e.at(t1), e.at(t0)));
+      }
+      break;
+    }
+    case ShapePart::Kind::Rectangle:
+    {
+      const double w = 0.5 * part.size[0], h = 0.5 * part.size[1];
+      const V2 c[4] = { world2(-w, -h), world2(w, -h), world2(w, h), world2(-w, h) };
+      for (int i = 0; i < 4; ++i)
+      {
+        pieces.push_back(makeSegment(c[i], c[(i + 1) % 4]));
+      }
+      break;
+    }
+    case ShapePart::Kind::Disk:
+      arc(part.radius, 0, 2 * Pi);
+      break;
+    default:
+      break;
+  }
+}
+
+double Prepared::partValue(const PreparedPart& pp, Vec3 w) const
+{
+  const ShapePart& p = *pp.part;
+  if (p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union)
+  {
+    const double fa = pp.a->value(w), fb = pp.b->value(w);
+    return p.kind == ShapePart::Kind::Union ? std::max(fa, fb) : blendUnion(fa, fb, p.amount);
+  }
+  Vec3 l = pp.toLocal.apply(w);
+  if (pp.dim <= 2)
+  {
+    l[2] = 0;
+  }
+  switch (p.kind)
+  {
+    case ShapePart::Kind::Rectangle:
+      return std::min(0.5 * p.size[0] - std::abs(l[0]), 0.5 * p.size[1] - std::abs(l[1]));
+    case ShapePart::Kind::Disk:
+      return p.radius - std::hypot(l[0], l[1]);
+    case ShapePart::Kind::CircularSegment:
+      return std::min(p.radius - std::hypot(l[0], l[1]), pp.hx * l[0] + pp.hy * l[1] - pp.hd);
+    case ShapePart::Kind::Box:
+      return std::min({ 0.5 * p.size[0] - std::abs(l[0]), 0.5 * p.size[1] - std::abs(l[1]),
+        0.5 * p.size[2] - std::abs(l[2]) });
+    case ShapePart::Kind::Sphere:
+      return p.radius - frep::norm(l);
+    case ShapePart::Kind::Field:
+    {
+      // One point at a time: the gradient evaluator is cheaper than a batch of one.
+      frep::Point3 unused;
+      double f = pp.eval->gradient(l, unused);
+      if (std::isnan(f))
+      {
+        f = -Inf;
+      }
+      const int axes = pp.dim == 2 ? 2 : 3;
+      for (int i = 0; i < axes; ++i)
+      {
+        f = std::min({ f, l[i] - pp.domain.lo[i], pp.domain.hi[i] - l[i] });
+      }
+      return f;
+    }
+    default:
+      return -Inf;
+  }
+}
+
+double Prepared::value(Vec3 w) const
+{
+  if (flat)
+  {
+    w[2] = 0;
+  }
+  double v = -Inf;
+  for (const auto& pp : parts)
+  {
+    if (pp.dim >= 2)
+    {
+      v = std::max(v, partValue(pp, w));
+    }
+  }
+  return v;
+}
+
+Interval Prepared::partBound(const PreparedPart& pp, const Box3& w) const
+{
+  const ShapePart& p = *pp.part;
+  if (p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union)
+  {
+    const Interval fa = pp.a->bound(w), fb = pp.b->bound(w);
+    return p.kind == ShapePart::Kind::Union ? ivMax(fa, fb) : blendUnion(fa, fb, p.amount);
+  }
+  Box3 l = mapBox(pp.toLocal, w);
+  if (pp.dim <= 2)
+  {
+    l.lo[2] = l.hi[2] = 0;
+  }
+  const Interval x = iv(l.lo[0], l.hi[0]), y = iv(l.lo[1], l.hi[1]), z = iv(l.lo[2], l.hi[2]);
+  auto half = [&](double s, Interval c)
+  {
+    return ivAdd(iv(0.5 * s, 0.5 * s), ivNeg(ivAbs(c)));
+  };
+  auto radial = [&](int axes)
+  {
+    // The nearest and farthest points of the box from the origin.
+    double near = 0, far = 0;
+    for (int i = 0; i < axes; ++i)
+    {
+      const double c = std::clamp(0.0, l.lo[i], l.hi[i]);
+      const double f = std::max(std::abs(l.lo[i]), std::abs(l.hi[i]));
+      near += c * c;
+      far += f * f;
+    }
+    return iv(p.radius - std::sqrt(far), p.radius - std::sqrt(near));
+  };
+  switch (p.kind)
+  {
+    case ShapePart::Kind::Rectangle:
+      return ivMin(half(p.size[0], x), half(p.size[1], y));
+    case ShapePart::Kind::Disk:
+      return radial(2);
+    case ShapePart::Kind::CircularSegment:
+    {
+      Interval h = ivAdd(ivScale(pp.hx, x), ivScale(pp.hy, y));
+      h = ivAdd(h, iv(-pp.hd, -pp.hd));
+      return ivMin(radial(2), h);
+    }
+    case ShapePart::Kind::Box:
+      return ivMin(ivMin(half(p.size[0], x), half(p.size[1], y)), half(p.size[2], z));
+    case ShapePart::Kind::Sphere:
+      return radial(3);
+    case ShapePart::Kind::Field:
+    {
+      Interval f = pp.eval->bound(l);
+      if (f.empty() || f.maybeNaN)
+      {
+        // NaN counts as outside in value(); an enclosure must allow it.
+        f = iv(-Inf, f.empty() ? -Inf : f.hi);
+      }
+      const int axes = pp.dim == 2 ? 2 : 3;
+      for (int i = 0; i < axes; ++i)
+      {
+        const Interval c = iv(l.lo[i], l.hi[i]);
+        f = ivMin(f, ivAdd(c, iv(-pp.domain.lo[i], -pp.domain.lo[i])));
+        f = ivMin(f, ivAdd(iv(pp.domain.hi[i], pp.domain.hi[i]), ivNeg(c)));
+      }
+      return f;
+    }
+    default:
+      return iv(-Inf, -Inf);
+  }
+}
+
+Interval Prepared::bound(Box3 w) const
+{
+  if (flat)
+  {
+    w.lo[2] = w.hi[2] = 0;
+  }
+  Interval r = iv(-Inf, -Inf);
+  for (const auto& pp : parts)
+  {
+    if (pp.dim >= 2)
+    {
+      r = ivMax(r, partBound(pp, w));
+    }
+  }
+  return r;
+}
+
+double Prepared::partGradient(const PreparedPart& pp, Vec3 w, Vec3& g) const
+{
+  const ShapePart& p = *pp.part;
+  if (p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union)
+  {
+    Vec3 ga, gb;
+    const double fa = pp.a->gradient(w, ga), fb = pp.b->gradient(w, gb);
+    if (p.kind == ShapePart::Kind::Union || p.amount <= 0)
+    {
+      g = fa >= fb ? ga : gb;
+      return std::max(fa, fb);
+    }
+    const double h = std::hypot(fa, fb), q = 1 + fa * fa + fb * fb;
+    const double da = 1 + (h > 0 ? fa / h : 0) - 2 * p.amount * fa / (q * q);
+    const double db = 1 + (h > 0 ? fb / h : 0) - 2 * p.amount * fb / (q * q);
+    for (int i = 0; i < 3; ++i)
+    {
+      g[i] = da * ga[i] + db * gb[i];
+    }
+    return blendUnion(fa, fb, p.amount);
+  }
+  Vec3 l = pp.toLocal.apply(w);
+  if (pp.dim <= 2)
+  {
+    l[2] = 0;
+  }
+  Vec3 gl{ 0, 0, 0 };
+  double v = -Inf;
+  auto faces = [&](int axes, const Vec3& half)
+  {
+    for (int i = 0; i < axes; ++i)
+    {
+      const double f = half[i] - std::abs(l[i]);
+      if (f < v || i == 0)
+      {
+        v = f;
+        gl = { 0, 0, 0 };
+        gl[i] = l[i] >= 0 ? -1 : 1;
+      }
+    }
+  };
+  auto radial = [&](int axes)
+  {
+    const double n = axes == 2 ? std::hypot(l[0], l[1]) : frep::norm(l);
+    v = p.radius - n;
+    gl = { 0, 0, 0 };
+    for (int i = 0; i < axes && n > 0; ++i)
+    {
+      gl[i] = -l[i] / n;
+    }
+  };
+  switch (p.kind)
+  {
+    case ShapePart::Kind::Rectangle:
+      faces(2, { 0.5 * p.size[0], 0.5 * p.size[1], 0 });
+      break;
+    case ShapePart::Kind::Box:
+      faces(3, { 0.5 * p.size[0], 0.5 * p.size[1], 0.5 * p.size[2] });
+      break;
+    case ShapePart::Kind::Disk:
+      radial(2);
+      break;
+    case ShapePart::Kind::Sphere:
+      radial(3);
+      break;
+    case ShapePart::Kind::CircularSegment:
+    {
+      radial(2);
+      const double c = pp.hx * l[0] + pp.hy * l[1] - pp.hd;
+      if (c < v)
+      {
+        v = c;
+        gl = { pp.hx, pp.hy, 0 };
+      }
+      break;
+    }
+    case ShapePart::Kind::Field:
+    {
+      frep::Point3 fg{ 0, 0, 0 };
+      v = pp.eval->gradient(l, fg);
+      gl = fg;
+      if (!std::isfinite(v) || !finite3(gl))
+      {
+        v = std::isnan(v) ? -Inf : v;
+        gl = { 0, 0, 0 };
+      }
+      const int axes = pp.dim == 2 ? 2 : 3;
+      if (axes == 2)
+      {
+        gl[2] = 0;
+      }
+      for (int i = 0; i < axes; ++i)
+      {
+        if (l[i] - pp.domain.lo[i] < v)
+        {
+          v = l[i] - pp.domain.lo[i];
+          gl = { 0, 0, 0 };
+          gl[i] = 1;
+        }
+        if (pp.domain.hi[i] - l[i] < v)
+        {
+          v = pp.domain.hi[i] - l[i];
+          gl = { 0, 0, 0 };
+          gl[i] = -1;
+        }
+      }
+      break;
+    }
+    default:
+      break;
+  }
+  const auto& ai = pp.toLocal.a;
+  for (int j = 0; j < 3; ++j)
+  {
+    g[j] = gl[0] * ai[j] + gl[1] * ai[3 + j] + gl[2] * ai[6 + j];
+  }
+  return v;
+}
+
+double Prepared::gradient(Vec3 w, Vec3& g) const
+{
+  if (flat)
+  {
+    w[2] = 0;
+  }
+  double v = -Inf;
+  g = { 0, 0, 0 };
+  for (const auto& pp : parts)
+  {
+    if (pp.dim >= 2)
+    {
+      Vec3 gp;
+      const double f = partGradient(pp, w, gp);
+      if (f > v)
+      {
+        v = f;
+        g = gp;
+      }
+    }
+  }
+  if (flat)
+  {
+    g[2] = 0;
+  }
+  return v;
+}
+
+double Prepared::boundaryDistance(const Vec3& w) const
+{
+  Vec3 g;
+  const double v = gradient(w, g);
+  const double n = frep::norm(g);
+  return n > 0 ? std::abs(v) / n : (v == 0 ? 0 : Inf);
+}
+
+const std::vector<Vec3>& Prepared::insideSamples() const
+{
+  if (!sampled_)
+  {
+    sampled_ = true;
+    const int n = flat ? 32 : 16;
+    const Box3 b = bounds;
+    for (int k = 0; k < (flat ? 1 : n); ++k)
+    {
+      for (int j = 0; j < n; ++j)
+      {
+        for (int i = 0; i < n; ++i)
+        {
+          const Vec3 p{ b.lo[0] + (i + 0.5) / n * (b.hi[0] - b.lo[0]),
+            b.lo[1] + (j + 0.5) / n * (b.hi[1] - b.lo[1]),
+            flat ? 0.0 : b.lo[2] + (k + 0.5) / n * (b.hi[2] - b.lo[2]) };
+          if (value(p) >= 0)
+          {
+            inside_.push_back(p);
+          }
+        }
+      }
+    }
+  }
+  return inside_;
+}
+
+double defaultTolerance(const Prepared& a, const Prepared& b, const QueryOptions& o)
+{
+  if (o.tolerance > 0)
+  {
+    return o.tolerance;
+  }
+  return 1e-9 * std::max(boxDiagonal(joinBoxes(a.bounds, b.bounds)), 1e-300);
+}
+
+void checkOptions(const PlacedShape& a, const PlacedShape& b, const QueryOptions& o)
+{
+  if (!std::isfinite(o.tolerance) || o.tolerance < 0 || o.arcSegments < 3)
+  {
+    failPair(a, b, "the query tolerance must be finite and >= 0, arcSegments >= 3");
+  }
+  validate(a);
+  validate(b);
+}
+
+bool searchBoxes(const Box3& box, bool flat, double minSize,
+  const std::function<double(const Box3&)>& promise,
+  const std::function<bool(const Vec3&)>& witness, int budget, std::vector<Box3>* leaves)
+{
+  struct Item
+  {
+    double promise;
+    Box3 box;
+    bool operator<(const Item& o) const { return promise < o.promise; }
+  };
+  std::priority_queue<Item> queue;
+  auto push = [&](const Box3& b)
+  {
+    const double p = promise(b);
+    if (!(p < 0))
+    {
+      queue.push({ p, b });
+    }
+  };
+  push(box);
+  int visited = 0;
+  while (!queue.empty() && visited < budget)
+  {
+    const Box3 b = queue.top().box;
+    queue.pop();
+    ++visited;
+    if (witness(b.centre()))
+    {
+      return true;
+    }
+    int axis = 0;
+    for (int i = 1; i < (flat ? 2 : 3); ++i)
+    {
+      if (b.hi[i] - b.lo[i] > b.hi[axis] - b.lo[axis])
+      {
+        axis = i;
+      }
+    }
+    if (b.hi[axis] - b.lo[axis] <= minSize)
+    {
+      if (leaves && leaves->size() < 4096)
+      {
+        leaves->push_back(b);
+      }
+      continue;
+    }
+    const double mid = 0.5 * (b.lo[axis] + b.hi[axis]);
+    Box3 lo = b, hi = b;
+    lo.hi[axis] = mid;
+    hi.lo[axis] = mid;
+    push(lo);
+    push(hi);
+  }
+  return false;
+}
+
+Box3 flatten(Box3 b, bool flat)
+{
+  if (flat)
+  {
+    b.lo[2] = b.hi[2] = 0;
+  }
+  return b;
+}
+
+Box3 padded(Box3 b, double pad)
+{
+  for (int i = 0; i < 3; ++i)
+  {
+    b.lo[i] -= pad;
+    b.hi[i] += pad;
+  }
+  return b;
+}
+
+} // namespace ictk::geometry::detail

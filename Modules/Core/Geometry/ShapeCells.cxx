@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Placed shapes as complex cells (ShapeCells.h): explicit geometry where the parts are
+// polygonal, the shape's world field (worldField) as implicit geometry otherwise.
+#include "Geometry/ShapeCells.h"
+
+#include "Geometry/Prepared.h"
+
+#include "FRep/Expr.h"
+#include "FRep/Tape.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace ictk::geometry
+{
+using namespace detail;
+
+complex::Cell toComplexCell(const PlacedShape& s, complex::CellKind kind, const QueryOptions& o)
+{
+  validate(s);
+  const Prepared p(s);
+  complex::Cell cell;
+  cell.name = s.cell;
+  cell.dimension = p.dim;
+  cell.kind = kind;
+  bool explicitOnly = true;
+  for (const auto& pp : p.parts)
+  {
+    const auto k = pp.part->kind;
+    explicitOnly = explicitOnly &&
+      (k == ShapePart::Kind::Point || k == ShapePart::Kind::Segment ||
+        k == ShapePart::Kind::Polyline || k == ShapePart::Kind::Arc ||
+        k == ShapePart::Kind::Rectangle || k == ShapePart::Kind::Box) &&
+      pp.dim == p.dim;
+  }
+  if (explicitOnly)
+  {
+    complex::ExplicitGeometry g;
+    auto add = [&](const Vec3& local)
+    {
+      g.points.push_back(s.place.apply(local));
+      return static_cast<std::uint32_t>(g.points.size() - 1);
+    };
+    for (const auto& pp : p.parts)
+    {
+      const ShapePart& part = *pp.part;
+      switch (part.kind)
+      {
+        case ShapePart::Kind::Point:
+          for (const auto& q : part.points)
+          {
+            add(q);
+          }
+          break;
+        case ShapePart::Kind::Segment:
+        case ShapePart::Kind::Polyline:
+        {
+          std::vector<std::uint32_t> line;
+          for (const auto& q : part.points)
+          {
+            line.push_back(add(q));
+          }
+          g.polylines.push_back(line);
+          break;
+        }
+        case ShapePart::Kind::Arc:
+        {
+          const double t0 = std::atan2(part.points[0][1], part.points[0][0]);
+          double t1 = std::atan2(part.points[1][1], part.points[1][0]);
+          while (t1 <= t0)
+          {
+            t1 += 2 * Pi;
+          }
+          const int n =
+            std::max(2, static_cast<int>(std::ceil(o.arcSegments * (t1 - t0) / (2 * Pi))));
+          std::vector<std::uint32_t> line;
+          for (int i = 0; i <= n; ++i)
+          {
+            const double t = t0 + (t1 - t0) * i / n;
+            line.push_back(add({ part.radius * std::cos(t), part.radius * std::sin(t), 0 }));
+          }
+          g.polylines.push_back(line);
+          break;
+        }
+        case ShapePart::Kind::Rectangle:
+        {
+          const double w = 0.5 * part.size[0], h = 0.5 * part.size[1];
+          const auto c0 = add({ -w, -h, 0 }), c1 = add({ w, -h, 0 }), c2 = add({ w, h, 0 }),
+                     c3 = add({ -w, h, 0 });
+          g.triangles.push_back({ c0, c1, c2 });
+          g.triangles.push_back({ c0, c2, c3 });
+          break;
+        }
+        case ShapePart::Kind::Box:
+        {
+          std::uint32_t c[8];
+          for (int k = 0; k < 8; ++k)
+          {
+            c[k] = add({ (k & 1 ? 0.5 : -0.5) * part.size[0], (k & 2 ? 0.5 : -0.5) * part.size[1],
+              (k & 4 ? 0.5 : -0.5) * part.size[2] });
+          }
+          // Six tetrahedra around the diagonal 0-7 (the Kuhn split of the cube).
+          const int paths[6][2] = { { 1, 3 }, { 1, 5 }, { 2, 3 }, { 2, 6 }, { 4, 5 }, { 4, 6 } };
+          for (const auto& q : paths)
+          {
+            g.tetrahedra.push_back({ c[0], c[q[0]], c[q[1]], c[7] });
+          }
+          break;
+        }
+        default:
+          break;
+      }
+    }
+    if (cell.kind != complex::CellKind::Point && cell.kind != complex::CellKind::BRep)
+    {
+      // An explicit geometry is a P or B cell whatever the model called it.
+      cell.kind = p.dim == 0 ? complex::CellKind::Point : complex::CellKind::BRep;
+    }
+    cell.geometry = std::move(g);
+    return cell;
+  }
+  if (p.dim < 2)
+  {
+    fail(s, "mixes points and curves of different dimensions; no single complex cell holds it");
+  }
+  complex::ImplicitGeometry g;
+  g.inside.push_back(worldField(s));
+  g.insideText.push_back("shape of " + s.cell);
+  g.bounds = p.bounds;
+  if (p.flat)
+  {
+    g.carriers.push_back(frep::tapeField(frep::Tape::compile(frep::Expr::z())));
+    g.carrierText.push_back("z");
+    // A thin slab about z = 0, so that the box has a thickness for discretisers.
+    const double pad = 1e-3 * p.scale;
+    g.bounds.lo[2] = -pad;
+    g.bounds.hi[2] = pad;
+  }
+  if (cell.kind == complex::CellKind::Point || cell.kind == complex::CellKind::BRep ||
+    cell.kind == complex::CellKind::MappedFRep)
+  {
+    cell.kind = complex::CellKind::FRep;
+  }
+  cell.geometry = std::move(g);
+  return cell;
+}
+
+} // namespace ictk::geometry
