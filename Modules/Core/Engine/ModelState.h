@@ -4,7 +4,9 @@
 // and by nothing else: no public header includes it. What the model was built into (cells,
 // instances, relations, attributes, events, animation curves as specs), the parameter table and
 // the stepper, the structural state that rides in the stepper's snapshots, and the scope through
-// which the interpreter's code sees it all.
+// which the interpreter's code sees it all. Its members are defined by concern: building from the
+// syntax tree in ModelBuild.cxx, values, placements and the scope in ModelValues.cxx, running
+// (reactions, instances, frames) in ModelRun.cxx, the library calls of code in ModelLibrary.cxx.
 
 #include "Dynamics/Animation.h"
 #include "Dynamics/Stepper.h"
@@ -237,6 +239,9 @@ struct ModelState
   void step(double dt);
   void settle();
 };
+
+/// Flattens `a.b.c` (Name and Member nodes) into names; false for anything else.
+bool pathOf(const Expr& e, std::vector<std::string>& out);
 
 /// What code inside a cell's, an instance's or the model's procedures sees.
 class EngineScope : public Scope
