@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The engine that runs .icm models (Modules/Core/Engine), on the exemplars of thesis ch. 4.4 and 5
 // (Data/Models/icm). Every expected value is derived by hand in the comment next to it.
+#include "Engine/Builtins.h"
 #include "Engine/DynamicModel.h"
 #include "Geometry/Queries.h"
 #include "Lang/Icm.h"
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <string>
 
 namespace
@@ -471,4 +473,96 @@ TEST(EngineExemplars, OneRecordPerRequestedFrame)
     for (const FrameRecord& r : m.advanceTo(i * 0.1, 0.1))
       records += r.transition ? 0 : 1;
   EXPECT_EQ(records, 20u);
+}
+
+// One table of built-ins (Lang/IcmBuiltins.h): the engine implements every entry once, in the
+// layer the entry names, and nothing else.
+TEST(EngineBuiltins, EveryEntryHasOneImplementation)
+{
+  const std::vector<std::string> problems = ictk::engine::implementationProblems();
+  std::string all;
+  for (const std::string& p : problems)
+    all += p + "\n";
+  EXPECT_TRUE(problems.empty()) << all;
+  EXPECT_EQ(ictk::engine::interpreterBuiltins().size() + ictk::engine::libraryBuiltins().size(),
+    ictk::lang::icm::builtins().size());
+}
+
+// docs/icm.md's table of built-ins is the table's rendering (builtinsMarkdown): the rows after the
+// `<!-- builtins` marker, up to the first line that is not a row, header excluded.
+TEST(Docs, IcmBuiltins)
+{
+  std::ifstream in(std::string(ICTK_DATA_DIR) + "/../docs/icm.md");
+  ASSERT_TRUE(in) << "docs/icm.md";
+  std::string line, rows;
+  bool marker = false, table = false;
+  while (std::getline(in, line))
+  {
+    if (!marker)
+    {
+      marker = line.rfind("<!-- builtins", 0) == 0;
+      continue;
+    }
+    if (line.rfind("|---", 0) == 0)
+    {
+      table = true;
+      continue;
+    }
+    if (!table)
+      continue;
+    if (line.rfind("|", 0) != 0)
+      break;
+    rows += line + "\n";
+  }
+  ASSERT_TRUE(marker) << "docs/icm.md has no <!-- builtins marker";
+  EXPECT_EQ(rows, ictk::lang::icm::builtinsMarkdown())
+    << "docs/icm.md's built-ins differ from Lang/IcmBuiltins.cxx; the table's rows should be:\n"
+    << ictk::lang::icm::builtinsMarkdown();
+}
+
+// An instance's cells are its template's minus the removed plus the added, in the template's order
+// then the added ones' (thesis L1459, I_j = TI \ {...} U {...}).
+TEST(EngineInstances, CellsDeriveFromTheTemplate)
+{
+  // EGG_GOING_DOWN = TEMPLATE_IC1.CELLS \ { Melting_egg } + Eggshell (App. C).
+  DynamicModel m = load("andyhausen.icm");
+  m.start();
+  std::vector<std::string> names;
+  for (const auto& c : m.cells())
+    names.push_back(c.name);
+  const std::vector<std::string> expected = { "Handle1", "Handle2", "Barrel", "Rope", "Hook",
+    "Egg_contents", "Liquid", "Eggshell" };
+  EXPECT_EQ(names, expected);
+
+  DynamicModel d = fromText("CELLS { A { shape = disk(1); dim = 2D; }\n"
+                            "  B { shape = disk(2); dim = 2D; }\n"
+                            "  C { shape = disk(3); dim = 2D; } }\n"
+                            "T : TEMPLATE_IC { CELLS { A B; } }\n"
+                            "I { CELLS { USE T.CELLS \\ { A } U { C }; } }\n");
+  d.start();
+  names.clear();
+  for (const auto& c : d.cells())
+    names.push_back(c.name);
+  EXPECT_EQ(names, (std::vector<std::string>{ "B", "C" }));
+}
+
+// Exactly one instance is valid at a time (L1394-1396): two valid ones are an error naming both.
+TEST(EngineErrors, SeveralValidInstancesAreNamed)
+{
+  const std::string text = "CELLS { A { shape = disk(1); dim = 2D; } }\n"
+                           "K : TEMPLATE_IC { CELLS { A; } }\n"
+                           "ONE : K { }\n"
+                           "TWO : K { PREDICATE { bool evaluate(REAL g, REAL l, REAL dt) { "
+                           "return A.translation.x < 1.0; } } }\n";
+  DynamicModel m = fromText(text);
+  try
+  {
+    m.start();
+    FAIL() << "expected a ModelError";
+  }
+  catch (const ModelError& e)
+  {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("several instances are valid: ONE, TWO"), std::string::npos) << what;
+  }
 }

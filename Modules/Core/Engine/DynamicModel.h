@@ -27,6 +27,8 @@
 namespace ictk::engine
 {
 
+struct ModelState;
+
 struct RunOptions
 {
   /// Transitions between instances are located to this time (bisection on the identity of the
@@ -108,11 +110,8 @@ public:
   /// The evaluation lists of the active instance's dependency plan (names), for traces and tests.
   std::vector<std::vector<std::string>> evaluationOrder() const;
 
-  /// Opaque; public only so the engine's own helpers can name it.
-  struct Impl;
-
 private:
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<ModelState> impl_; ///< Engine/ModelState.h, internal to the engine
 };
 
 } // namespace ictk::engine

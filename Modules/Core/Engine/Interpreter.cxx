@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Engine/Interpreter.h"
 
+#include "Engine/Builtins.h"
+
 #include "FRep/Vector.h"
 
 #include <algorithm>
@@ -422,10 +424,23 @@ Value Interpreter::eval(const Expr& e, Frame& f) const
   fail(e.pos, "unsupported expression");
 }
 
-Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame& f) const
+namespace
 {
-  const std::string& name = call.text;
-  auto num = [&](std::size_t i)
+
+/// A call of a Math built-in: its arguments, with the checks every implementation shares.
+struct MathCall
+{
+  lang::icm::BuiltinId id;
+  const std::string& file;
+  const Expr& call;
+  const std::string& name;
+  const std::vector<Value>& args;
+
+  [[noreturn]] void fail(Pos pos, const std::string& message) const
+  {
+    throw ModelError(file, pos, message);
+  }
+  double num(std::size_t i) const
   {
     bool ok = false;
     const double v = asNumber(args.at(i), ok);
@@ -434,127 +449,172 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
         "argument " + std::to_string(i + 1) + " of " + name + " must be a number, not a " +
           typeName(args[i].type));
     return v;
-  };
-  auto vec = [&](std::size_t i)
+  }
+  Vec3 vec(std::size_t i) const
   {
     if (args.at(i).type != Value::Type::Vec3)
       fail(call.kids[i + 1]->pos,
         "argument " + std::to_string(i + 1) + " of " + name + " must be a vec3, not a " +
           typeName(args[i].type));
     return args[i].vec;
-  };
-  auto arity = [&](std::size_t n)
+  }
+  bool ints() const { return args[0].type == Value::Type::Int && args[1].type == Value::Type::Int; }
+};
+
+using MathFunction = Value (*)(const MathCall&);
+
+using lang::icm::BuiltinId;
+
+/// The functions of one real argument.
+Value elementary(const MathCall& c)
+{
+  const double x = c.num(0);
+  switch (c.id)
   {
+    case BuiltinId::Abs:
+      return Value::real(std::fabs(x));
+    case BuiltinId::Sqrt:
+      return Value::real(std::sqrt(x));
+    case BuiltinId::Sin:
+      return Value::real(std::sin(x));
+    case BuiltinId::Cos:
+      return Value::real(std::cos(x));
+    case BuiltinId::Tan:
+      return Value::real(std::tan(x));
+    case BuiltinId::Asin:
+      return Value::real(std::asin(x));
+    case BuiltinId::Acos:
+      return Value::real(std::acos(x));
+    case BuiltinId::Atan:
+      return Value::real(std::atan(x));
+    case BuiltinId::Exp:
+      return Value::real(std::exp(x));
+    case BuiltinId::Log:
+      return Value::real(std::log(x));
+    default:
+      c.fail(c.call.pos, c.name + ": not a function of one real");
+  }
+}
+
+/// The interpreter's half of the built-in library (the Math entries of lang::icm::builtins()).
+const std::pair<BuiltinId, MathFunction> kMath[] = {
+  { BuiltinId::Vec3,
+    [](const MathCall& c)
+    {
+      return Value::vector({ c.num(0), c.num(1), c.num(2) });
+    } },
+  { BuiltinId::Length,
+    [](const MathCall& c)
+    {
+      return Value::real(frep::norm(c.vec(0)));
+    } },
+  { BuiltinId::Dot,
+    [](const MathCall& c)
+    {
+      return Value::real(frep::dot(c.vec(0), c.vec(1)));
+    } },
+  { BuiltinId::Cross,
+    [](const MathCall& c)
+    {
+      return Value::vector(frep::cross(c.vec(0), c.vec(1)));
+    } },
+  { BuiltinId::Normalize,
+    [](const MathCall& c)
+    {
+      const Vec3 v = c.vec(0);
+      const double n = frep::norm(v);
+      if (n == 0.0)
+        c.fail(c.call.pos, "normalize of a zero vector");
+      return Value::vector({ v[0] / n, v[1] / n, v[2] / n });
+    } },
+  { BuiltinId::Abs, elementary },
+  { BuiltinId::Sqrt, elementary },
+  { BuiltinId::Sin, elementary },
+  { BuiltinId::Cos, elementary },
+  { BuiltinId::Tan, elementary },
+  { BuiltinId::Asin, elementary },
+  { BuiltinId::Acos, elementary },
+  { BuiltinId::Atan, elementary },
+  { BuiltinId::Exp, elementary },
+  { BuiltinId::Log, elementary },
+  { BuiltinId::Atan2,
+    [](const MathCall& c)
+    {
+      const double a = c.num(0), b = c.num(1);
+      return Value::real(std::atan2(a, b));
+    } },
+  { BuiltinId::Pow,
+    [](const MathCall& c)
+    {
+      const double a = c.num(0), b = c.num(1);
+      return Value::real(std::pow(a, b));
+    } },
+  { BuiltinId::Min,
+    [](const MathCall& c)
+    {
+      const double a = c.num(0), b = c.num(1);
+      return c.ints() ? Value::integer(std::min(a, b)) : Value::real(std::min(a, b));
+    } },
+  { BuiltinId::Max,
+    [](const MathCall& c)
+    {
+      const double a = c.num(0), b = c.num(1);
+      return c.ints() ? Value::integer(std::max(a, b)) : Value::real(std::max(a, b));
+    } },
+  { BuiltinId::Clamp,
+    [](const MathCall& c)
+    {
+      const double lo = c.num(1), hi = c.num(2);
+      if (!(lo <= hi))
+        c.fail(c.call.pos, "clamp: the lower bound is above the upper bound");
+      return Value::real(std::clamp(c.num(0), lo, hi));
+    } },
+  { BuiltinId::Floor,
+    [](const MathCall& c)
+    {
+      return Value::integer(std::floor(c.num(0)));
+    } },
+  { BuiltinId::Ceil,
+    [](const MathCall& c)
+    {
+      return Value::integer(std::ceil(c.num(0)));
+    } },
+};
+
+/// kMath by BuiltinId (nullptr for the Library entries).
+const std::vector<MathFunction>& mathById()
+{
+  static const std::vector<MathFunction> byId = []
+  {
+    std::vector<MathFunction> v(static_cast<std::size_t>(BuiltinId::Count), nullptr);
+    for (const auto& [id, fn] : kMath)
+      v.at(static_cast<std::size_t>(id)) = fn;
+    return v;
+  }();
+  return byId;
+}
+
+} // namespace
+
+std::vector<lang::icm::BuiltinId> interpreterBuiltins()
+{
+  return idsOf(kMath);
+}
+
+Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame& f) const
+{
+  const std::string& name = call.text;
+  const lang::icm::Builtin* builtin = lang::icm::findBuiltin(name);
+  if (builtin && builtin->layer == lang::icm::BuiltinLayer::Math)
+  {
+    const std::size_t n = static_cast<std::size_t>(builtin->call.minArgs);
     if (args.size() != n)
       fail(call.pos,
         name + " takes " + std::to_string(n) + " argument(s), got " + std::to_string(args.size()));
-  };
-  using Unary = double (*)(double);
-  static const std::map<std::string, Unary> unary = {
-    { "abs",
-      [](double x)
-      {
-        return std::fabs(x);
-      } },
-    { "sqrt",
-      [](double x)
-      {
-        return std::sqrt(x);
-      } },
-    { "sin",
-      [](double x)
-      {
-        return std::sin(x);
-      } },
-    { "cos",
-      [](double x)
-      {
-        return std::cos(x);
-      } },
-    { "tan",
-      [](double x)
-      {
-        return std::tan(x);
-      } },
-    { "asin",
-      [](double x)
-      {
-        return std::asin(x);
-      } },
-    { "acos",
-      [](double x)
-      {
-        return std::acos(x);
-      } },
-    { "atan",
-      [](double x)
-      {
-        return std::atan(x);
-      } },
-    { "exp",
-      [](double x)
-      {
-        return std::exp(x);
-      } },
-    { "log",
-      [](double x)
-      {
-        return std::log(x);
-      } },
-  };
-  if (auto it = unary.find(name); it != unary.end())
-  {
-    arity(1);
-    return Value::real(it->second(num(0)));
-  }
-  if (name == "floor" || name == "ceil")
-  {
-    arity(1);
-    return Value::integer(name == "floor" ? std::floor(num(0)) : std::ceil(num(0)));
-  }
-  if (name == "atan2" || name == "pow" || name == "min" || name == "max")
-  {
-    arity(2);
-    const double a = num(0), b = num(1);
-    const double r = name == "atan2" ? std::atan2(a, b)
-      : name == "pow"                ? std::pow(a, b)
-      : name == "min"                ? std::min(a, b)
-                                     : std::max(a, b);
-    const bool ints = (name == "min" || name == "max") && args[0].type == Value::Type::Int &&
-      args[1].type == Value::Type::Int;
-    return ints ? Value::integer(r) : Value::real(r);
-  }
-  if (name == "clamp")
-  {
-    arity(3);
-    const double lo = num(1), hi = num(2);
-    if (!(lo <= hi))
-      fail(call.pos, "clamp: the lower bound is above the upper bound");
-    return Value::real(std::clamp(num(0), lo, hi));
-  }
-  if (name == "vec3")
-  {
-    arity(3);
-    return Value::vector({ num(0), num(1), num(2) });
-  }
-  if (name == "length" || name == "normalize")
-  {
-    arity(1);
-    const Vec3 v = vec(0);
-    const double n = frep::norm(v);
-    if (name == "length")
-      return Value::real(n);
-    if (n == 0.0)
-      fail(call.pos, "normalize of a zero vector");
-    return Value::vector({ v[0] / n, v[1] / n, v[2] / n });
-  }
-  if (name == "dot" || name == "cross")
-  {
-    arity(2);
-    const Vec3 a = vec(0), b = vec(1);
-    if (name == "dot")
-      return Value::real(frep::dot(a, b));
-    return Value::vector(frep::cross(a, b));
+    const MathFunction fn = mathById()[static_cast<std::size_t>(builtin->id)];
+    if (!fn)
+      fail(call.pos, name + ": no implementation of this built-in");
+    return fn(MathCall{ builtin->id, file_, call, name, args });
   }
   if (functions_)
     for (const Procedure& p : *functions_)
@@ -575,9 +635,11 @@ Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame
         f.iterations = inner.iterations;
         return inner.result;
       }
+  if (!builtin)
+    fail(call.pos, name + ": unknown function '" + name + "'");
   try
   {
-    return f.scope.call(name, args);
+    return f.scope.call(*builtin, args);
   }
   catch (const ModelError&)
   {

@@ -8,6 +8,7 @@
 
 #include "Geometry/PlacedShape.h"
 #include "Lang/IcmAst.h"
+#include "Lang/IcmBuiltins.h"
 
 #include <map>
 #include <memory>
@@ -74,10 +75,10 @@ public:
   virtual bool member(const Value& base, const std::string& member, Value& out) = 0;
   /// Assigns to a bare name or to Cell.member (member empty for a bare name); false = unknown.
   virtual bool assign(const std::string& name, const std::string& member, const Value& v) = 0;
-  /// A library call the interpreter does not compute itself (geometry between cells, events,
-  /// animation curves, shapes of T-cells, setShapeParameter). Throws std::runtime_error on bad
-  /// arguments (the interpreter adds the place).
-  virtual Value call(const std::string& name, const std::vector<Value>& args) = 0;
+  /// A built-in of the Library layer (Lang/IcmBuiltins.h: geometry between cells, events,
+  /// animation curves, shapes of T-cells, setShapeParameter), which the interpreter does not
+  /// compute itself. Throws std::runtime_error on bad arguments (the interpreter adds the place).
+  virtual Value call(const lang::icm::Builtin& builtin, const std::vector<Value>& args) = 0;
 };
 
 class Interpreter

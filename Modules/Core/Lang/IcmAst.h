@@ -251,20 +251,4 @@ struct Model
   const CellDef* animation(const std::string& name) const;
 };
 
-/// One function of the built-in library callable from reactions, predicates and functions.
-struct Builtin
-{
-  const char* name;
-  int minArgs;
-  int maxArgs; ///< -1: any number
-  const char* signature;
-  const char* result; ///< real, int, bool, vec3, string, shape or void
-};
-/// The reaction library (docs/icm.md lists it); nullptr when `name` is not one of them.
-const Builtin* findBuiltin(const std::string& name);
-/// The shape constructors allowed in a cell's `shape =`; nullptr when unknown.
-const Builtin* findShapeBuiltin(const std::string& name);
-const std::vector<Builtin>& builtins();
-const std::vector<Builtin>& shapeBuiltins();
-
 } // namespace ictk::lang::icm

@@ -1,0 +1,217 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The running model's half of the built-in library (Lang/IcmBuiltins.h, the Library layer):
+// geometry between cells, events, animation curves, shapes of T-cells and FRep shape parameters,
+// one function per entry in kLibrary (Engine/Builtins.h checks it against the table).
+#include "Engine/Builtins.h"
+#include "Engine/ModelState.h"
+#include "Geometry/Queries.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace ictk::engine
+{
+
+namespace
+{
+
+/// A call of a Library built-in: the model it runs in, through the calling code's scope.
+struct LibraryCall
+{
+  const lang::icm::Builtin& builtin;
+  EngineScope& scope;
+  ModelState& m;
+  const std::vector<Value>& args;
+};
+
+using LibraryFunction = Value (*)(const LibraryCall&);
+using lang::icm::BuiltinId;
+
+Value distanceOf(const LibraryCall& c)
+{
+  return Value::real(geometry::distance(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
+}
+
+Value intersectsOf(const LibraryCall& c)
+{
+  return Value::boolean(geometry::intersects(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
+}
+
+Value containsOf(const LibraryCall& c)
+{
+  return Value::boolean(geometry::contains(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
+}
+
+Value intersectionCountOf(const LibraryCall& c)
+{
+  return Value::integer(static_cast<double>(intersectionPoints(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry)
+                                              .size()));
+}
+
+Value intersectionPointOf(const LibraryCall& c)
+{
+  const auto pts = intersectionPoints(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry);
+  const double i = c.args.at(2).number;
+  if (!(i >= 0) || i >= static_cast<double>(pts.size()))
+    throw std::runtime_error("index " + std::to_string(static_cast<long long>(i)) +
+      " out of range: the cells meet in " + std::to_string(pts.size()) + " point(s)");
+  return Value::vector(pts[static_cast<std::size_t>(i)]);
+}
+
+Value intersectionAreaOf(const LibraryCall& c)
+{
+  return Value::real(intersectionMeasure(
+    *c.scope.cellShape(c.args.at(0)), *c.scope.cellShape(c.args.at(1)), c.m.options.geometry));
+}
+
+/// segment(p, q), arc(p, q, r), circularSegment(p, q, r): a shape part in local coordinates.
+Value shapePartOf(const LibraryCall& c)
+{
+  const BuiltinId id = c.builtin.id;
+  ShapePart p;
+  p.kind = id == BuiltinId::Segment ? ShapePart::Kind::Segment
+    : id == BuiltinId::Arc          ? ShapePart::Kind::Arc
+                                    : ShapePart::Kind::CircularSegment;
+  for (std::size_t i = 0; i < 2; ++i)
+    if (c.args.at(i).type != Value::Type::Vec3)
+      throw std::runtime_error("argument " + std::to_string(i + 1) + " must be a vec3");
+  p.points = { c.args[0].vec, c.args[1].vec };
+  if (id != BuiltinId::Segment)
+    p.radius = c.args.at(2).number;
+  Value v;
+  v.type = Value::Type::Shape;
+  v.shape = std::make_shared<const std::vector<ShapePart>>(std::vector<ShapePart>{ p });
+  return v;
+}
+
+Value setShapeParameter(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const std::vector<Value>& args = call.args;
+  const Value& cell = args.at(0);
+  if (cell.type != Value::Type::Cell)
+    throw std::runtime_error("the first argument is a cell");
+  const CellSpec& c = m.cells[m.cellIndex.at(cell.text)];
+  if (!c.tape)
+    throw std::runtime_error("the cell " + cell.text + " has no HyperFun or XML shape");
+  // "a[2]" or "a2": HyperFun's parameter array, counted from 1.
+  std::string key = args.at(1).text;
+  key.erase(std::remove_if(
+              key.begin(), key.end(), [](char ch) { return ch == '[' || ch == ']' || ch == 'a'; }),
+    key.end());
+  char* end = nullptr;
+  const long index = std::strtol(key.c_str(), &end, 10);
+  if (key.empty() || *end != '\0' || index < 1 || index > c.parameterCount)
+    throw std::runtime_error("the shape of " + cell.text + " has the parameters a[1] to a[" +
+      std::to_string(c.parameterCount) + "], not '" + args.at(1).text + "'");
+  auto& values = m.s.shapeParameters[cell.text];
+  if (values.empty())
+    values.assign(static_cast<std::size_t>(c.parameterCount), 0.0);
+  const double v = args.at(2).number;
+  if (!std::isfinite(v))
+    throw std::runtime_error("the value is not finite");
+  if (values[static_cast<std::size_t>(index - 1)] != v)
+  {
+    values[static_cast<std::size_t>(index - 1)] = v;
+    m.bumpVersion(cell.text);
+  }
+  return {};
+}
+
+Value fireEvent(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const std::vector<Value>& args = call.args;
+  const std::string ev = args.at(0).text;
+  if (ev == "TIME_REJECTED")
+  {
+    if (!m.context)
+      throw std::runtime_error("TIME_REJECTED outside a frame (in a predicate?)");
+    m.context->rejectTime(args.size() > 1 ? args[1].number : kNaN);
+    return {};
+  }
+  if (!m.eventNames.count(ev))
+    throw std::runtime_error("unknown event " + ev);
+  const auto& names = m.eventParams.at(ev);
+  if (args.size() - 1 != names.size())
+    throw std::runtime_error(ev + " has " + std::to_string(names.size()) + " parameter(s)");
+  std::map<std::string, double> params;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    params[names[i]] = args[i + 1].number;
+  const double now = m.context ? m.context->globalT : m.stepper->time();
+  dyn::Event e = dyn::Event::at(ev, now, m.eventPriority.at(ev), params);
+  if (m.context)
+    m.context->fireEvent(e);
+  else
+    m.stepper->fireEvent(e);
+  return {};
+}
+
+/// animation(curve, t), animationValue(curve, t), animationDuration(curve).
+Value animationOf(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const BuiltinId id = call.builtin.id;
+  const std::string curve = call.args.at(0).text;
+  if (!m.curveNames.count(curve))
+    throw std::runtime_error("unknown animation \"" + curve + "\"");
+  const std::size_t width = m.curveWidth.at(curve);
+  if (id == BuiltinId::AnimationDuration)
+  {
+    const auto& c = width == 2 ? m.curves[3].at(curve) : m.curves[0].at(curve);
+    return Value::real(c.duration());
+  }
+  const double t = call.args.at(1).number;
+  if (id == BuiltinId::AnimationValue)
+  {
+    if (width != 2)
+      throw std::runtime_error("\"" + curve + "\" is a vector animation: use animation()");
+    return Value::real(m.curves[3].at(curve).evaluate(t));
+  }
+  if (width != 4)
+    throw std::runtime_error("\"" + curve + "\" is a scalar animation: use animationValue()");
+  return Value::vector({ m.curves[0].at(curve).evaluate(t), m.curves[1].at(curve).evaluate(t),
+    m.curves[2].at(curve).evaluate(t) });
+}
+
+/// The running model's half of the built-in library (the Library entries of
+/// lang::icm::builtins()).
+const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
+  { BuiltinId::Distance, distanceOf },
+  { BuiltinId::Intersects, intersectsOf },
+  { BuiltinId::Contains, containsOf },
+  { BuiltinId::IntersectionCount, intersectionCountOf },
+  { BuiltinId::IntersectionPoint, intersectionPointOf },
+  { BuiltinId::IntersectionArea, intersectionAreaOf },
+  { BuiltinId::FireEvent, fireEvent },
+  { BuiltinId::Animation, animationOf },
+  { BuiltinId::AnimationValue, animationOf },
+  { BuiltinId::AnimationDuration, animationOf },
+  { BuiltinId::Segment, shapePartOf },
+  { BuiltinId::Arc, shapePartOf },
+  { BuiltinId::CircularSegment, shapePartOf },
+  { BuiltinId::SetShapeParameter, setShapeParameter },
+};
+
+} // namespace
+
+std::vector<lang::icm::BuiltinId> libraryBuiltins()
+{
+  return idsOf(kLibrary);
+}
+
+Value EngineScope::call(const lang::icm::Builtin& builtin, const std::vector<Value>& args)
+{
+  for (const auto& [id, fn] : kLibrary)
+    if (id == builtin.id)
+      return fn(LibraryCall{ builtin, *this, m_, args });
+  throw std::runtime_error(std::string("unknown function '") + builtin.call.name + "'");
+}
+
+} // namespace ictk::engine

@@ -1,0 +1,277 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// The state of a running model (DynamicModel's private part), shared by the engine's own sources
+// and by nothing else: no public header includes it. What the model was built into (cells,
+// instances, relations, attributes, events, animation curves as specs), the parameter table and
+// the stepper, the structural state that rides in the stepper's snapshots, and the scope through
+// which the interpreter's code sees it all. Its members are defined by concern: building from the
+// syntax tree in ModelBuild.cxx, values, placements and the scope in ModelValues.cxx, running
+// (reactions, instances, frames) in ModelRun.cxx, the library calls of code in ModelLibrary.cxx.
+
+#include "Dynamics/Animation.h"
+#include "Dynamics/Stepper.h"
+#include "Engine/DynamicModel.h"
+#include "FRep/Tape.h"
+
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+
+namespace ictk::engine
+{
+
+using geometry::Affine;
+using geometry::PlacedShape;
+using geometry::PlacedShapePtr;
+using geometry::QueryOptions;
+using geometry::ShapePart;
+using geometry::Vec3;
+using lang::icm::CellDef;
+using lang::icm::Expr;
+using lang::icm::ExprPtr;
+using lang::icm::Instance;
+using lang::icm::ParamDecl;
+using lang::icm::Pos;
+using lang::icm::Procedure;
+using lang::icm::Property;
+using lang::icm::Relation;
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+inline constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+// The instance entity comes first in its plan: its update is the one that drives the cells.
+inline constexpr double kInstancePriority = 1e300;
+
+/// A parameter of a cell, an instance or the model.
+struct ParamSpec
+{
+  Pos pos;
+  std::string name;
+  Value initial;
+};
+
+/// `alias name` in STATE_PARAMETERS: a name for a path (a parameter of a cell or the instance).
+struct AliasSpec
+{
+  std::string name;
+  ExprPtr path;
+};
+
+struct CellSpec
+{
+  std::string name;
+  Pos pos;
+  complex::CellKind kind = complex::CellKind::FRep;
+  int dimension = 3;
+  frep::Box3 domain;
+  bool hasDomain = false;
+  bool hasLifespan = false;
+  dyn::TimeSpan life = dyn::TimeSpan::infinite();
+  bool hasClock = false;
+  dyn::TimeSpan clock = dyn::TimeSpan::infinite();
+  double priority = 0.0;
+  std::vector<ShapePart> parts; ///< from `shape =` (empty: a T-cell set by reactions)
+  /// A HyperFun/XML field, kept as a tape so setShapeParameter can rebind its parameters.
+  frep::TapePtr tape;
+  int parameterCount = 0;
+  std::size_t fieldPart = kNone;
+  /// blend(A, B, amount) / union(A, B): operands are cells, placed when the shape is needed.
+  struct Operands
+  {
+    ShapePart::Kind kind = ShapePart::Kind::Union;
+    std::string a, b;
+    double amount = 0.0;
+  };
+  std::optional<Operands> operands;
+  std::vector<ParamSpec> params;
+  std::map<std::string, const Procedure*> reactions; ///< "update", "react:EVENT", ...
+};
+
+struct RelationSpec
+{
+  Pos pos;
+  std::string name;
+  std::string master, masterMember; ///< cell (or instance/model parameter) and member path
+  std::string dependent, dependentMember;
+  double priority = 1.0;
+  bool hierarchical = false;
+};
+
+/// An attribute (thesis L864): a HyperFun function of the cell's local coordinates, or an
+/// external mapping known only by name (no function: it is not evaluated).
+struct AttributeSpec
+{
+  std::string name;
+  frep::TapePtr tape;
+  int dimension = 3;
+  std::string text;
+};
+
+struct InstanceSpec
+{
+  std::string name;
+  Pos pos;
+  bool isTemplate = false;
+  std::vector<std::string> cells;
+  std::vector<RelationSpec> boundary, containment, dependency;
+  std::vector<ParamSpec> params;       ///< instance parameters and typed state parameters
+  std::vector<std::string> stateNames; ///< typed state parameters and aliases, in order
+  std::vector<AliasSpec> aliases;
+  std::map<std::string, const Procedure*> reactions;
+  std::map<std::string, std::map<std::string, const Procedure*>> cellReactions;
+  const Procedure* predicate = nullptr;
+  std::set<std::string> reactsTo;
+  std::vector<std::pair<std::string, std::string>> attributeLinks; ///< (cell, attribute)
+};
+
+/// The structural state: what the parameter table cannot hold. Copied with every snapshot.
+struct Structure
+{
+  std::size_t active = kNone;
+  std::size_t previous = kNone;
+  bool justActivated = false;
+  double activatedAt = 0.0;
+  std::map<std::string, double> presentSince;
+  std::map<std::string, std::shared_ptr<const std::vector<ShapePart>>> shapes; ///< set by code
+  std::map<std::string, std::vector<double>> shapeParameters;
+  std::map<std::string, std::uint64_t> versions;
+  std::map<std::string, Value> texts; ///< non-numeric parameters (strings)
+};
+
+struct ModelState
+{
+  lang::IcmModel model;
+  RunOptions options;
+  std::string file;
+  Interpreter interpreter;
+  std::vector<CellSpec> cells;
+  std::map<std::string, std::size_t> cellIndex;
+  std::vector<InstanceSpec> instances;
+  std::map<std::string, std::size_t> instanceIndex;
+  std::map<std::string, dyn::AnimationCurve> curves[4]; ///< per component x, y, z, and scalar
+  std::set<std::string> curveNames;
+  std::map<std::string, std::size_t> curveWidth;
+  std::map<std::string, AttributeSpec> attributes;
+  std::vector<ParamSpec> modelParams;
+  std::vector<std::string> modelStateNames;
+  std::set<std::string> eventNames;
+  std::map<std::string, double> eventPriority;
+  std::map<std::string, std::vector<std::string>> eventParams;
+  std::map<std::string, dyn::TimeSpan> eventSpans;
+  std::map<std::string, dyn::TimeSpan> timespans;
+  dyn::ParameterTable table;
+  std::map<std::string, Value::Type> types; ///< qualified parameter -> type
+  std::unique_ptr<dyn::Stepper> stepper;
+  Structure s;
+  std::size_t graphInstance = kNone;
+  bool started = false;
+  std::size_t processedSeen = 0;
+  std::uint64_t nextVersion = 1;
+  dyn::StepContext* context = nullptr; ///< the frame being evaluated (events, TIME_REJECTED)
+
+  ModelState(lang::IcmModel m, RunOptions o)
+    : model(std::move(m))
+    , options(std::move(o))
+    , file(model.fileName)
+    , interpreter(model.fileName, &model.functions)
+  {
+  }
+
+  [[noreturn]] void fail(Pos p, const std::string& message) const
+  {
+    throw ModelError(file, p, message);
+  }
+
+  // ---- building --------------------------------------------------------------------------
+  void build();
+  void buildTimespans();
+  void buildAnimations();
+  void buildEvents();
+  void buildCell(const CellDef& def);
+  void buildShape(CellSpec& c, const Property& p);
+  void buildInstance(const Instance& in);
+  std::vector<std::string> cellsOf(const Instance& in, int depth) const;
+  std::vector<RelationSpec> relationsOf(
+    const Instance& in, const std::string& kind, int depth) const;
+  RelationSpec relationSpec(const Relation& r) const;
+  void buildAttributes(const lang::icm::AttributesSection& section);
+  std::vector<std::pair<std::string, std::string>> attributeLinksOf(
+    const Instance& in, int depth) const;
+  void addParam(const std::string& owner, const ParamSpec& p);
+  Value initialValue(const ParamDecl& p);
+  void buildStepper();
+  dyn::DependencyGraph graph(std::size_t instance) const;
+
+  // ---- values ----------------------------------------------------------------------------
+  std::string qualified(const std::string& owner, const std::string& name) const
+  {
+    return owner.empty() ? name : owner + "." + name;
+  }
+  bool hasParam(const std::string& q) const { return types.count(q) > 0; }
+  Value get(const std::string& q) const;
+  void set(const std::string& q, const Value& v);
+
+  // ---- shapes ----------------------------------------------------------------------------
+  bool present(const std::string& cell) const
+  {
+    if (s.active == kNone)
+      return false;
+    const auto& cs = instances[s.active].cells;
+    return std::find(cs.begin(), cs.end(), cell) != cs.end();
+  }
+  std::shared_ptr<const std::vector<ShapePart>> partsOf(const CellSpec& c) const;
+  Affine localPlace(const std::string& cell) const;
+  Affine place(const std::string& cell, int depth = 0) const;
+  PlacedShapePtr shapeOf(const std::string& cell, int depth = 0) const;
+  std::uint64_t versionOf(const std::string& cell, int depth = 0) const;
+  void bumpVersion(const std::string& cell) { s.versions[cell] = nextVersion++; }
+
+  // ---- running ---------------------------------------------------------------------------
+  const Procedure* procedureFor(const std::string& cell, const std::string& key) const;
+  void runCell(const std::string& cell, const std::string& key, dyn::StepContext& c,
+    const dyn::Event* ev = nullptr);
+  void runInstance(
+    std::size_t i, const std::string& key, dyn::StepContext& c, const dyn::Event* ev = nullptr);
+  void activate(dyn::StepContext& c);
+  std::vector<std::size_t> validInstances(double t);
+  void setActive(std::size_t i, double t);
+  FrameRecord record(double t, bool transition);
+  void step(double dt);
+  void settle();
+};
+
+/// Flattens `a.b.c` (Name and Member nodes) into names; false for anything else.
+bool pathOf(const Expr& e, std::vector<std::string>& out);
+
+/// What code inside a cell's, an instance's or the model's procedures sees.
+class EngineScope : public Scope
+{
+public:
+  EngineScope(ModelState& m, std::string cell, std::size_t instance)
+    : m_(m)
+    , cell_(std::move(cell))
+    , instance_(instance)
+  {
+  }
+
+  bool lookup(const std::string& name, Value& out) override;
+  bool member(const Value& base, const std::string& member, Value& out) override;
+  bool assign(const std::string& name, const std::string& member, const Value& v) override;
+  Value call(const lang::icm::Builtin& builtin, const std::vector<Value>& args) override;
+
+  ModelState& model() const { return m_; }
+  /// The placed shape of a cell argument (std::runtime_error for another value or a T-cell
+  /// without a shape yet).
+  PlacedShapePtr cellShape(const Value& v) const;
+
+private:
+  /// The qualified parameter a bare name stands for, or "".
+  std::string resolve(const std::string& name) const;
+  const AliasSpec* alias(const std::string& name) const;
+
+  ModelState& m_;
+  std::string cell_;
+  std::size_t instance_;
+};
+
+} // namespace ictk::engine

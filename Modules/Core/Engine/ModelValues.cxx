@@ -1,0 +1,399 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Resolving values and placements in a running model (ModelState.h): parameters by qualified
+// name, value paths (Cell.translation.x), the placement and placed shape of a cell, the version
+// that tells when a shape changed, and the scope through which code sees names and members.
+#include "Engine/ModelState.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace ictk::engine
+{
+
+namespace
+{
+
+std::uint64_t mix(std::uint64_t h, std::uint64_t v)
+{
+  h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+  return h;
+}
+
+std::uint64_t bitsOf(double d)
+{
+  std::uint64_t u = 0;
+  std::memcpy(&u, &d, sizeof u);
+  return u;
+}
+
+} // namespace
+
+bool pathOf(const Expr& e, std::vector<std::string>& out)
+{
+  if (e.kind == Expr::Kind::Name)
+  {
+    out.push_back(e.text);
+    return true;
+  }
+  if (e.kind == Expr::Kind::Member && pathOf(*e.kids[0], out))
+  {
+    out.push_back(e.text);
+    return true;
+  }
+  if (e.kind == Expr::Kind::Index && pathOf(*e.kids[0], out))
+    return true; // Andy.skeleton["hand"]: the array as a whole
+  return false;
+}
+
+// ---- values ---------------------------------------------------------------------------------
+
+Value ModelState::get(const std::string& q) const
+{
+  auto t = types.find(q);
+  if (t == types.end())
+    throw std::out_of_range("no parameter " + q);
+  const dyn::ParameterTable& p = stepper ? stepper->params() : table;
+  switch (t->second)
+  {
+    case Value::Type::Vec3:
+      return Value::vector({ p.value(q + ".x"), p.value(q + ".y"), p.value(q + ".z") });
+    case Value::Type::Real:
+      return Value::real(p.value(q));
+    case Value::Type::Int:
+      return Value::integer(p.value(q));
+    case Value::Type::Bool:
+      return Value::boolean(p.value(q) != 0.0);
+    default:
+    {
+      auto it = s.texts.find(q);
+      return it == s.texts.end() ? Value{} : it->second;
+    }
+  }
+}
+
+void ModelState::set(const std::string& q, const Value& v)
+{
+  const Value::Type t = types.at(q);
+  // std::runtime_error, not ModelError: the interpreter adds the place of the assignment.
+  auto bad = [&]
+  {
+    throw std::runtime_error(
+      q + " is a " + std::string(typeName(t)) + "; it cannot take a " + typeName(v.type));
+  };
+  if (std::isnan(v.number) && v.isNumber())
+    throw std::runtime_error(q + " would become NaN");
+  dyn::ParameterTable& p = stepper ? stepper->params() : table;
+  switch (t)
+  {
+    case Value::Type::Vec3:
+      if (v.type != Value::Type::Vec3)
+        bad();
+      for (int i = 0; i < 3; ++i)
+      {
+        if (!std::isfinite(v.vec[i]))
+          throw std::runtime_error(q + " would become " + std::to_string(v.vec[i]));
+        p.setValue(q + "." + "xyz"[i], v.vec[i]);
+      }
+      break;
+    case Value::Type::Real:
+    case Value::Type::Int:
+      if (!v.isNumber() && v.type != Value::Type::Bool)
+        bad();
+      p.setValue(q, t == Value::Type::Int ? std::trunc(v.number) : v.number);
+      break;
+    case Value::Type::Bool:
+      if (v.type != Value::Type::Bool)
+        bad();
+      p.setValue(q, v.number);
+      break;
+    default:
+      if (t != Value::Type::None && v.type != t)
+        bad();
+      s.texts[q] = v;
+      break;
+  }
+}
+
+// ---- shapes ---------------------------------------------------------------------------------
+
+std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec& c) const
+{
+  if (auto it = s.shapes.find(c.name); it != s.shapes.end())
+    return it->second;
+  auto parts = std::make_shared<std::vector<ShapePart>>(c.parts);
+  if (c.fieldPart != kNone)
+    if (auto it = s.shapeParameters.find(c.name); it != s.shapeParameters.end())
+      (*parts)[c.fieldPart].field = frep::tapeField(c.tape, 0.0, it->second);
+  return parts;
+}
+
+Affine ModelState::localPlace(const std::string& cell) const
+{
+  const dyn::ParameterTable& p = stepper->params();
+  auto v = [&](const char* prop)
+  {
+    const std::string q = cell + "." + prop;
+    return Vec3{ p.value(q + ".x"), p.value(q + ".y"), p.value(q + ".z") };
+  };
+  return Affine::fromTransform(v("translation"), v("rotation"), v("scale"));
+}
+
+Affine ModelState::place(const std::string& cell, int depth) const
+{
+  if (depth > static_cast<int>(cells.size()))
+    throw std::runtime_error("HIERARCHICAL dependencies form a cycle through " + cell);
+  Affine local = localPlace(cell);
+  if (s.active == kNone)
+    return local;
+  // The first hierarchical parent in the active instance carries the cell.
+  for (const RelationSpec& r : instances[s.active].dependency)
+    if (r.hierarchical && r.dependent == cell && cellIndex.count(r.master))
+      return place(r.master, depth + 1) * local;
+  return local;
+}
+
+PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
+{
+  if (depth > static_cast<int>(cells.size()))
+    throw std::runtime_error("the shapes of blend/union cells refer to each other in a cycle");
+  const CellSpec& c = cells[cellIndex.at(cell)];
+  auto shape = std::make_shared<PlacedShape>();
+  shape->cell = c.name;
+  shape->dimension = c.dimension;
+  shape->place = place(cell);
+  if (c.operands && !s.shapes.count(cell))
+  {
+    ShapePart part;
+    part.kind = c.operands->kind;
+    part.operandA = shapeOf(c.operands->a, depth + 1);
+    part.operandB = shapeOf(c.operands->b, depth + 1);
+    part.amount = c.operands->amount;
+    part.bounds = c.domain;
+    shape->parts.push_back(part);
+    return shape;
+  }
+  shape->parts = *partsOf(c);
+  return shape;
+}
+
+std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
+{
+  const CellSpec& c = cells[cellIndex.at(cell)];
+  std::uint64_t v = 0;
+  if (auto it = s.versions.find(cell); it != s.versions.end())
+    v = it->second;
+  if (!c.operands || s.shapes.count(cell) || depth > static_cast<int>(cells.size()))
+    return v;
+  // A blend or union lives in world coordinates: it changes when an operand moves.
+  for (const std::string& o : { c.operands->a, c.operands->b })
+  {
+    v = mix(v, versionOf(o, depth + 1));
+    const Affine a = place(o);
+    for (double d : a.a)
+      v = mix(v, bitsOf(d));
+    for (double d : a.b)
+      v = mix(v, bitsOf(d));
+  }
+  return v;
+}
+
+// ---- EngineScope ----------------------------------------------------------------------------
+
+std::string EngineScope::resolve(const std::string& name) const
+{
+  if (!cell_.empty() && m_.hasParam(cell_ + "." + name))
+    return cell_ + "." + name;
+  if (instance_ != kNone && m_.hasParam(m_.instances[instance_].name + "." + name))
+    return m_.instances[instance_].name + "." + name;
+  if (m_.hasParam(name))
+    return name;
+  return {};
+}
+
+const AliasSpec* EngineScope::alias(const std::string& name) const
+{
+  if (instance_ == kNone)
+    return nullptr;
+  for (const AliasSpec& a : m_.instances[instance_].aliases)
+    if (a.name == name)
+      return &a;
+  return nullptr;
+}
+
+bool EngineScope::lookup(const std::string& name, Value& out)
+{
+  if (const std::string q = resolve(name); !q.empty())
+  {
+    out = m_.get(q);
+    return true;
+  }
+  if (const AliasSpec* a = alias(name))
+  {
+    out = m_.interpreter.evaluate(*a->path, *this);
+    return true;
+  }
+  if (m_.cellIndex.count(name))
+  {
+    out = Value::cell(name);
+    return true;
+  }
+  if (m_.curveNames.count(name))
+  {
+    out = Value::string(name);
+    return true;
+  }
+  return false;
+}
+
+bool EngineScope::member(const Value& base, const std::string& member, Value& out)
+{
+  if (base.type != Value::Type::Cell)
+    return false;
+  const std::string& c = base.text;
+  const std::string q = c + "." + member;
+  if (m_.hasParam(q))
+  {
+    out = m_.get(q);
+    return true;
+  }
+  const CellSpec& spec = m_.cells[m_.cellIndex.at(c)];
+  if (member == "center")
+  {
+    out = Value::vector(m_.place(c).apply({ 0, 0, 0 }));
+    return true;
+  }
+  if (member == "curDomain" || member == "domain")
+  {
+    frep::Box3 b = spec.domain;
+    if (member == "curDomain")
+      b = m_.shapeOf(c)->worldBounds();
+    out = Value::vector({ b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2] });
+    return true;
+  }
+  if (member == "dim")
+  {
+    out = Value::integer(spec.dimension);
+    return true;
+  }
+  if (member == "type")
+  {
+    out = Value::string(complex::kindCode(spec.kind));
+    return true;
+  }
+  if (member == "priority")
+  {
+    out = Value::real(spec.priority);
+    return true;
+  }
+  if (member == "shape")
+  {
+    out.type = Value::Type::Shape;
+    out.shape = m_.partsOf(spec);
+    return true;
+  }
+  if (member == "radius")
+  {
+    for (const ShapePart& p : *m_.partsOf(spec))
+      if (p.radius > 0.0)
+      {
+        out = Value::real(p.radius);
+        return true;
+      }
+  }
+  return false;
+}
+
+bool EngineScope::assign(const std::string& name, const std::string& member, const Value& v)
+{
+  if (member.empty())
+  {
+    if (const std::string q = resolve(name); !q.empty())
+    {
+      m_.set(q, v);
+      return true;
+    }
+    if (const AliasSpec* a = alias(name))
+    {
+      std::vector<std::string> path;
+      if (!pathOf(*a->path, path) || path.size() > 2)
+        throw std::runtime_error("the alias " + name + " names a path code cannot set");
+      return path.size() == 1 ? assign(path[0], {}, v) : assign(path[0], path[1], v);
+    }
+    return false;
+  }
+  if (!m_.cellIndex.count(name))
+  {
+    // instance.parameter or model parameter with a member: not assignable
+    return false;
+  }
+  const std::string q = name + "." + member;
+  if (m_.hasParam(q))
+  {
+    m_.set(q, v);
+    return true;
+  }
+  if (member == "shape")
+  {
+    if (v.type != Value::Type::Shape)
+      throw std::runtime_error(std::string("a shape takes segment(...), arc(...) or "
+                                           "circularSegment(...), not a ") +
+        typeName(v.type));
+    m_.s.shapes[name] = v.shape;
+    m_.bumpVersion(name);
+    return true;
+  }
+  return false;
+}
+
+PlacedShapePtr EngineScope::cellShape(const Value& v) const
+{
+  if (v.type != Value::Type::Cell)
+    throw std::runtime_error(std::string("expected a cell, got a ") + typeName(v.type));
+  const CellSpec& c = m_.cells[m_.cellIndex.at(v.text)];
+  if (!c.operands && m_.partsOf(c)->empty())
+    throw std::runtime_error("the cell " + v.text + " has no shape yet");
+  return m_.shapeOf(v.text);
+}
+
+// ---- DynamicModel::value ------------------------------------------------------------------
+
+Value DynamicModel::value(const std::string& path) const
+{
+  ModelState& m = *impl_;
+  if (m.hasParam(path))
+    return m.get(path);
+  const auto dot = path.find('.');
+  EngineScope scope(m, {}, m.s.active);
+  Value v;
+  if (dot == std::string::npos)
+  {
+    if (scope.lookup(path, v))
+      return v;
+    throw std::out_of_range("no parameter '" + path + "'");
+  }
+  const std::string head = path.substr(0, dot);
+  std::string rest = path.substr(dot + 1);
+  if (!scope.lookup(head, v))
+    throw std::out_of_range("no cell or parameter '" + head + "'");
+  while (!rest.empty())
+  {
+    const auto d = rest.find('.');
+    const std::string member = rest.substr(0, d);
+    rest = d == std::string::npos ? std::string() : rest.substr(d + 1);
+    if (v.type == Value::Type::Vec3)
+    {
+      const int c = member == "x" ? 0 : member == "y" ? 1 : member == "z" ? 2 : -1;
+      if (c < 0)
+        throw std::out_of_range("a vec3 has no member '" + member + "'");
+      v = Value::real(v.vec[c]);
+      continue;
+    }
+    Value next;
+    if (!scope.member(v, member, next))
+      throw std::out_of_range("'" + path + "': no member '" + member + "'");
+    v = next;
+  }
+  return v;
+}
+
+} // namespace ictk::engine

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Lang/IcmBuiltins.h"
+
+#include <stdexcept>
+
+namespace ictk::lang::icm
+{
+
+const std::vector<Builtin>& builtins()
+{
+  using Id = BuiltinId;
+  constexpr BuiltinLayer math = BuiltinLayer::Math;
+  constexpr BuiltinLayer library = BuiltinLayer::Library;
+  static const std::vector<Builtin> table = {
+    // Geometry between cells (their current domains, in global coordinates).
+    { Id::Distance, library, { "distance", 2, 2, "distance(cellA, cellB)", "real" },
+      "the distance between the cells' current domains" },
+    { Id::Intersects, library, { "intersects", 2, 2, "intersects(cellA, cellB)", "bool" },
+      "whether the cells meet" },
+    { Id::Contains, library, { "contains", 2, 2, "contains(cellA, cellB)", "bool" }, "B inside A" },
+    { Id::IntersectionCount, library,
+      { "intersectionCount", 2, 2, "intersectionCount(cellA, cellB)", "int" },
+      "the number of intersection points" },
+    { Id::IntersectionPoint, library,
+      { "intersectionPoint", 3, 3, "intersectionPoint(cellA, cellB, int i)", "vec3" },
+      "the i-th intersection point (from 0)" },
+    { Id::IntersectionArea, library,
+      { "intersectionArea", 2, 2, "intersectionArea(cellA, cellB)", "real" },
+      "the measure of the cells' overlap" },
+    // Events.
+    { Id::FireEvent, library, { "fireEvent", 1, -1, "fireEvent(EVENT, args...)", "void" },
+      "one argument per event parameter; `fireEvent(TIME_REJECTED, dt)` retries the frame with "
+      "the step dt" },
+    // Animation curves (thesis Table 3) by name.
+    { Id::Animation, library, { "animation", 2, 2, "animation(string curve, real t)", "vec3" },
+      "a vector curve of ANIMATIONS at t" },
+    { Id::AnimationValue, library,
+      { "animationValue", 2, 2, "animationValue(string curve, real t)", "real" },
+      "a scalar curve of ANIMATIONS at t" },
+    { Id::AnimationDuration, library,
+      { "animationDuration", 1, 1, "animationDuration(string curve)", "real" },
+      "the duration of a curve" },
+    // Shapes computed in reactions (T-cells) and FRep parameters.
+    { Id::Segment, library, { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" },
+      "for T-cells: `KL_segment.shape = segment(p, q)`" },
+    { Id::Arc, library, { "arc", 3, 3, "arc(vec3 p, vec3 q, real radius)", "shape" },
+      "counter-clockwise from p to q about the origin" },
+    { Id::CircularSegment, library,
+      { "circularSegment", 3, 3, "circularSegment(vec3 p, vec3 q, real radius)", "shape" },
+      "the region between that arc and its chord" },
+    { Id::SetShapeParameter, library,
+      { "setShapeParameter", 3, 3, "setShapeParameter(cell, string name, real value)", "void" },
+      "sets an FRep parameter (`a[1]`...) of an F-cell's HyperFun or XML shape" },
+    // Vectors.
+    { Id::Vec3, math, { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" }, "a vector" },
+    { Id::Length, math, { "length", 1, 1, "length(vec3 v)", "real" }, "the Euclidean norm" },
+    { Id::Dot, math, { "dot", 2, 2, "dot(vec3 a, vec3 b)", "real" }, "the dot product" },
+    { Id::Cross, math, { "cross", 2, 2, "cross(vec3 a, vec3 b)", "vec3" }, "the cross product" },
+    { Id::Normalize, math, { "normalize", 1, 1, "normalize(vec3 v)", "vec3" },
+      "v / length(v) (an error for the zero vector)" },
+    // Scalars.
+    { Id::Abs, math, { "abs", 1, 1, "abs(real x)", "real" }, "the absolute value" },
+    { Id::Sqrt, math, { "sqrt", 1, 1, "sqrt(real x)", "real" }, "the square root" },
+    { Id::Sin, math, { "sin", 1, 1, "sin(real x)", "real" }, "radians" },
+    { Id::Cos, math, { "cos", 1, 1, "cos(real x)", "real" }, "radians" },
+    { Id::Tan, math, { "tan", 1, 1, "tan(real x)", "real" }, "radians" },
+    { Id::Asin, math, { "asin", 1, 1, "asin(real x)", "real" }, "radians" },
+    { Id::Acos, math, { "acos", 1, 1, "acos(real x)", "real" }, "radians" },
+    { Id::Atan, math, { "atan", 1, 1, "atan(real x)", "real" }, "radians" },
+    { Id::Atan2, math, { "atan2", 2, 2, "atan2(real y, real x)", "real" }, "the angle of (x, y)" },
+    { Id::Exp, math, { "exp", 1, 1, "exp(real x)", "real" }, "e^x" },
+    { Id::Log, math, { "log", 1, 1, "log(real x)", "real" }, "the natural logarithm" },
+    { Id::Pow, math, { "pow", 2, 2, "pow(real x, real y)", "real" }, "x^y" },
+    { Id::Min, math, { "min", 2, 2, "min(real a, real b)", "real" },
+      "the smaller (an int for two ints)" },
+    { Id::Max, math, { "max", 2, 2, "max(real a, real b)", "real" },
+      "the larger (an int for two ints)" },
+    { Id::Clamp, math, { "clamp", 3, 3, "clamp(real x, real lo, real hi)", "real" },
+      "x limited to [lo, hi] (an error when lo > hi)" },
+    { Id::Floor, math, { "floor", 1, 1, "floor(real x)", "int" }, "rounded down" },
+    { Id::Ceil, math, { "ceil", 1, 1, "ceil(real x)", "int" }, "rounded up" },
+  };
+  return table;
+}
+
+const Builtin& builtin(BuiltinId id)
+{
+  const Builtin& b = builtins().at(static_cast<std::size_t>(id));
+  if (b.id != id)
+    throw std::logic_error(std::string("the table of built-ins is out of order at ") + b.call.name);
+  return b;
+}
+
+const Builtin* findBuiltin(const std::string& name)
+{
+  for (const Builtin& b : builtins())
+    if (name == b.call.name)
+      return &b;
+  return nullptr;
+}
+
+std::string builtinsMarkdown()
+{
+  std::string out;
+  for (const Builtin& b : builtins())
+    out += std::string("| `") + b.call.signature + "` | " + b.call.result + ": " + b.doc + " |\n";
+  return out;
+}
+
+const std::vector<Signature>& shapeBuiltins()
+{
+  static const std::vector<Signature> table = {
+    { "file", 1, 1, "file(string path)  .hf or .xml (FRep), .obj or .off (mesh)", "shape" },
+    { "point", 3, 3, "point(real x, real y, real z)", "shape" },
+    { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" },
+    { "arc", 3, 3, "arc(vec3 p, vec3 q, real radius)", "shape" },
+    { "polyline", 2, -1, "polyline(vec3 p0, vec3 p1, ...)", "shape" },
+    { "rectangle", 2, 2, "rectangle(real width, real height)", "shape" },
+    { "disk", 1, 1, "disk(real radius)", "shape" },
+    { "box", 3, 3, "box(real sx, real sy, real sz)", "shape" },
+    { "sphere", 1, 1, "sphere(real radius)", "shape" },
+    { "blend", 3, 3, "blend(cellA, cellB, real amount)", "shape" },
+    { "union", 2, 2, "union(cellA, cellB)", "shape" },
+    { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" },
+  };
+  return table;
+}
+
+const Signature* findShapeBuiltin(const std::string& name)
+{
+  for (const Signature& s : shapeBuiltins())
+    if (name == s.name)
+      return &s;
+  return nullptr;
+}
+
+} // namespace ictk::lang::icm

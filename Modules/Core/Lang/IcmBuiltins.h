@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// The built-in library of the IC model language (docs/icm.md "Built-in library"), in one table:
+// each entry names a built-in, its arguments and result, a line of documentation, and the layer
+// that computes it. Everything else comes from this table: the checker's signatures and argument
+// counts (IcmCheck), the engine's dispatch (the interpreter computes the pure math; the running
+// model computes the library calls: geometry between cells, events, animation curves, shapes of
+// T-cells), and the table of docs/icm.md, which a test compares with builtinsMarkdown().
+//
+// The table lives here, below the engine, so that the checker needs no engine; the engine keeps
+// one implementation per BuiltinId and a test fails when an entry has no implementation or an
+// implementation has no entry (Engine/Builtins.h).
+
+#include <string>
+#include <vector>
+
+namespace ictk::lang::icm
+{
+
+/// One per built-in of the reaction library, in the table's order.
+enum class BuiltinId
+{
+  Distance,
+  Intersects,
+  Contains,
+  IntersectionCount,
+  IntersectionPoint,
+  IntersectionArea,
+  FireEvent,
+  Animation,
+  AnimationValue,
+  AnimationDuration,
+  Segment,
+  Arc,
+  CircularSegment,
+  SetShapeParameter,
+  Vec3,
+  Length,
+  Dot,
+  Cross,
+  Normalize,
+  Abs,
+  Sqrt,
+  Sin,
+  Cos,
+  Tan,
+  Asin,
+  Acos,
+  Atan,
+  Atan2,
+  Exp,
+  Log,
+  Pow,
+  Min,
+  Max,
+  Clamp,
+  Floor,
+  Ceil,
+  Count ///< not a built-in: the number of them
+};
+
+/// Who computes a built-in.
+enum class BuiltinLayer
+{
+  Math,   ///< the interpreter, from its arguments alone
+  Library ///< the running model (geometry between cells, events, animation, shapes)
+};
+
+/// A call's shape: what the checker needs.
+struct Signature
+{
+  const char* name;
+  int minArgs;
+  int maxArgs; ///< -1: any number
+  const char* signature;
+  const char* result; ///< real, int, bool, vec3, string, shape or void
+};
+
+/// One function of the built-in library callable from reactions, predicates and functions.
+struct Builtin
+{
+  BuiltinId id;
+  BuiltinLayer layer;
+  Signature call;
+  const char* doc; ///< one line for docs/icm.md
+};
+
+/// The reaction library, indexed by BuiltinId.
+const std::vector<Builtin>& builtins();
+const Builtin& builtin(BuiltinId id);
+/// nullptr when `name` is not one of the built-ins.
+const Builtin* findBuiltin(const std::string& name);
+/// The rows of docs/icm.md's table of built-ins ("| `signature` | result: doc |"), one per entry.
+std::string builtinsMarkdown();
+
+/// The shape constructors allowed in a cell's `shape =` (computed when the model is built, not in
+/// code); nullptr when unknown.
+const Signature* findShapeBuiltin(const std::string& name);
+const std::vector<Signature>& shapeBuiltins();
+
+} // namespace ictk::lang::icm

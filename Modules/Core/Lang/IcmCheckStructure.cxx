@@ -1,0 +1,500 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The checks of a model's structure: cells (their sources, properties, parameters and shapes) and
+// attributes.
+#include "Lang/IcmChecker.h"
+
+namespace ictk::lang::icmcheck
+{
+
+const std::set<std::string>& Checker::paramsOf(const CellDef* c, int depth) const
+{
+  static const std::set<std::string> none;
+  if (!c || depth > 64)
+  {
+    return none;
+  }
+  const auto it = paramsCache_.find(c);
+  if (it != paramsCache_.end())
+  {
+    return it->second;
+  }
+  if (!paramsBusy_.insert(c).second)
+  {
+    return none; // a cycle of '<-'
+  }
+  std::set<std::string> out = paramsOfImpl(c, depth);
+  paramsBusy_.erase(c);
+  return paramsCache_.emplace(c, std::move(out)).first->second;
+}
+
+std::set<std::string> Checker::paramsOfImpl(const CellDef* c, int depth) const
+{
+  std::set<std::string> out;
+  for (const ParamDecl& p : c->parameters)
+  {
+    out.insert(p.name.text);
+  }
+  if (!c->source.text.empty())
+  {
+    const auto found = allCells_.find(c->source.text);
+    const CellDef* src = found == allCells_.end() ? nullptr : found->second;
+    if (src != c)
+    {
+      for (const std::string& s : paramsOf(src, depth + 1))
+      {
+        out.insert(s);
+      }
+    }
+  }
+  return out;
+}
+
+void Checker::cellMember(const Expr& path, const CellMap& cells)
+{
+  // Find the member right after the root.
+  const Expr* e = &path;
+  const Expr* first = nullptr;
+  while (!e->kids.empty())
+  {
+    if (e->kind == Expr::Kind::Member)
+    {
+      first = e;
+    }
+    else
+    {
+      first = nullptr; // an index right after the root
+    }
+    e = e->kids[0].get();
+  }
+  const auto it = cells.find(e->text);
+  if (first == nullptr || it == cells.end() || it->second == nullptr)
+  {
+    return;
+  }
+  if (first->kids[0].get() != e)
+  {
+    return;
+  }
+  if (cellProperties().count(first->text) == 0 && paramsOf(it->second).count(first->text) == 0)
+  {
+    err(first->pos, "cell '" + e->text + "' has no parameter '" + first->text + "'");
+  }
+}
+
+void Checker::cell(const CellDef& c, const CellMap& cells, const Instance* in)
+{
+  if (!c.source.text.empty())
+  {
+    if (c.source.text == c.name.text)
+    {
+      err(c.source.pos, "cell '" + c.name.text + "' cannot be a copy of itself");
+    }
+    else if (cells.count(c.source.text) == 0 && globalCells_.count(c.source.text) == 0)
+    {
+      err(c.source.pos, "undefined cell '" + c.source.text + "' after '<-'");
+    }
+    else
+    {
+      // The chain of copies must not come back to this cell.
+      const CellDef* x = &c;
+      for (int step = 0; step < 64 && x && !x->source.text.empty(); ++step)
+      {
+        const auto it = allCells_.find(x->source.text);
+        x = it == allCells_.end() ? nullptr : it->second;
+        if (x == &c)
+        {
+          err(c.source.pos,
+            "cell '" + c.name.text + "' is a copy of itself (through '" + c.source.text + "')");
+          break;
+        }
+      }
+    }
+  }
+  std::set<std::string> seen;
+  for (const Property& p : c.properties)
+  {
+    if (!seen.insert(p.name).second)
+    {
+      err(p.pos, "property '" + p.name + "' given twice");
+    }
+    property(p, cells);
+  }
+  std::map<std::string, const ParamDecl*> ps;
+  params(c.parameters, ps, &cells, "parameter");
+  reactionsOf(c.reactions, cells, in, &c);
+}
+
+void Checker::property(const Property& p, const CellMap& cells)
+{
+  const auto single = [&](Expr::Kind kind, const char* what)
+  {
+    if (p.isHyperFun || p.values.size() != 1 || p.values[0]->kind != kind)
+    {
+      err(p.values.empty() ? p.pos : start(*p.values[0]), std::string(what));
+      return false;
+    }
+    return true;
+  };
+  if (p.name == "type")
+  {
+    single(Expr::Kind::CellType, "type = P-CELL, F-CELL, C-CELL, B-CELL or T-CELL");
+  }
+  else if (p.name == "dim")
+  {
+    single(Expr::Kind::Dim, "dim = 0D, 1D, 2D, 3D or 4D");
+  }
+  else if (p.name == "priority")
+  {
+    priority(p);
+  }
+  else if (p.name == "timespan")
+  {
+    timespanRef(p);
+  }
+  else if (p.name == "lifespan")
+  {
+    if (p.values.size() == 1 && p.values[0]->kind == Expr::Kind::Name)
+    {
+      timespanRef(p);
+      return;
+    }
+    for (const ExprPtr& v : p.values)
+    {
+      double lo = 0;
+      double hi = 0;
+      if (v->kind != Expr::Kind::Brace || v->kids.size() != 2 || !constantNumber(v->kids[0], lo) ||
+        !constantNumber(v->kids[1], hi))
+      {
+        err(v->pos, "lifespan = a time span name or intervals '{start, end}, {start, end}'");
+      }
+      else if (hi < lo)
+      {
+        err(v->pos, "the interval ends before it starts");
+      }
+    }
+  }
+  else if (p.name == "domain")
+  {
+    if (!single(Expr::Kind::Brace,
+          "domain = { xmin, ymin, xmax, ymax } or { xmin, ymin, zmin, xmax, ymax, zmax }"))
+    {
+      return;
+    }
+    const ExprPtr& b = p.values[0];
+    std::vector<double> v;
+    for (const ExprPtr& k : b->kids)
+    {
+      double x = 0;
+      if (!constantNumber(k, x))
+      {
+        err(k->pos, "the domain's bounds are numbers");
+        return;
+      }
+      v.push_back(x);
+    }
+    if (v.size() != 4 && v.size() != 6)
+    {
+      err(b->pos, "a domain has 4 numbers (2D) or 6 (3D), found " + std::to_string(v.size()));
+      return;
+    }
+    const std::size_t n = v.size() / 2;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (v[i] > v[i + n])
+      {
+        err(b->kids[i]->pos, "the domain's minimum is above its maximum");
+      }
+    }
+  }
+  else if (p.name == "shape")
+  {
+    if (p.isHyperFun)
+    {
+      if (p.hyperFunText.find_first_not_of(" \t\r\n") == std::string::npos)
+      {
+        err(p.pos, "empty hyperfun block");
+        return;
+      }
+      hyperFun(p);
+      return;
+    }
+    for (const ExprPtr& v : p.values)
+    {
+      shape(v, cells);
+    }
+  }
+  else if (p.name == "mapping" && p.isHyperFun)
+  {
+    // an attribute function written in HyperFun
+    hyperFun(p);
+  }
+  else if (p.name == "mapping" || p.name == "deformation")
+  {
+    for (const ExprPtr& v : p.values)
+    {
+      if (v->kind == Expr::Kind::Call && v->text == "file")
+      {
+        shape(v, cells);
+      }
+      else if (v->kind != Expr::Kind::Name && v->kind != Expr::Kind::String)
+      {
+        err(v->pos, p.name + " = the name of an external mapping, a string or file(\"...\")");
+      }
+    }
+  }
+  else
+  {
+    err(p.pos,
+      "unknown property '" + p.name +
+        "': type, shape, dim, domain, lifespan, priority, timespan, mapping or deformation");
+  }
+}
+
+void Checker::hyperFun(const Property& p)
+{
+  try
+  {
+    (void)readHyperFun(p.hyperFunText, m_.fileName, {}, limits_);
+  }
+  catch (const ParseError& e)
+  {
+    for (const Diagnostic& d : e.diagnostics())
+    {
+      Pos at = p.hyperFunPos;
+      if (d.where.line > 1)
+      {
+        at.line += d.where.line - 1;
+        at.column = d.where.column;
+      }
+      else if (d.where.line == 1)
+      {
+        at.column += d.where.column - 1;
+      }
+      else
+      {
+        at = p.pos;
+      }
+      err(at, "in the hyperfun shape: " + d.message);
+    }
+  }
+}
+
+void Checker::shape(const ExprPtr& v, const CellMap& cells)
+{
+  if (v->kind != Expr::Kind::Call || v->text.empty())
+  {
+    err(v->pos,
+      "shape = hyperfun { ... }, file(\"model.hf\") or a shape constructor such as "
+      "disk(r)");
+    return;
+  }
+  const Signature* b = findShapeBuiltin(v->text);
+  const int n = static_cast<int>(v->kids.size()) - 1;
+  if (!b)
+  {
+    err(v->pos, "unknown shape constructor '" + v->text + "'");
+    return;
+  }
+  if (n < b->minArgs || (b->maxArgs >= 0 && n > b->maxArgs))
+  {
+    err(v->pos,
+      "'" + v->text + "' takes " + arity(*b) + " argument(s) (" + b->signature + "), found " +
+        std::to_string(n));
+    return;
+  }
+  if (v->text == "file")
+  {
+    const ExprPtr& a = v->kids[1];
+    if (a->kind != Expr::Kind::String)
+    {
+      err(a->pos, "file(\"path\") takes a quoted path");
+      return;
+    }
+    const std::string& path = a->text;
+    const auto dot = path.rfind('.');
+    const std::string ext = dot == std::string::npos ? std::string() : path.substr(dot);
+    if (ext != ".hf" && ext != ".xml" && ext != ".obj" && ext != ".off")
+    {
+      err(a->pos, "file \"" + path + "\": the shape files are .hf, .xml, .obj or .off");
+    }
+    return;
+  }
+  if (v->text == "blend" || v->text == "union")
+  {
+    for (std::size_t i = 1; i <= 2; ++i)
+    {
+      const ExprPtr& a = v->kids[i];
+      if (a->kind != Expr::Kind::Name ||
+        (cells.count(a->text) == 0 && globalCells_.count(a->text) == 0))
+      {
+        err(a->pos,
+          a->kind == Expr::Kind::Name ? "undefined cell '" + a->text + "'"
+                                      : "expected a cell name");
+      }
+    }
+    if (v->kids.size() > 3)
+    {
+      constant(v->kids[3]);
+    }
+    return;
+  }
+  for (std::size_t i = 1; i < v->kids.size(); ++i)
+  {
+    constant(v->kids[i]);
+  }
+}
+
+std::string Checker::arity(const Signature& b)
+{
+  if (b.maxArgs < 0)
+  {
+    return "at least " + std::to_string(b.minArgs);
+  }
+  if (b.minArgs == b.maxArgs)
+  {
+    return std::to_string(b.minArgs);
+  }
+  return std::to_string(b.minArgs) + " to " + std::to_string(b.maxArgs);
+}
+
+void Checker::collectAttributes(const AttributesSection& s, std::set<std::string>& out) const
+{
+  for (const auto& b : s.bindings)
+  {
+    out.insert(b.first.text);
+  }
+  for (const CellDef& d : s.defs)
+  {
+    out.insert(d.name.text);
+  }
+}
+
+void Checker::attributesOf(const Instance& in, std::set<std::string>& out, int depth) const
+{
+  const auto it = attributesCache_.find(&in);
+  if (it != attributesCache_.end())
+  {
+    out.insert(it->second.begin(), it->second.end());
+    return;
+  }
+  if (depth > 64 || !attributesBusy_.insert(&in).second)
+  {
+    return;
+  }
+  std::set<std::string> mine;
+  attributesOfImpl(in, mine, depth);
+  attributesBusy_.erase(&in);
+  out.insert(mine.begin(), mine.end());
+  attributesCache_.emplace(&in, std::move(mine));
+}
+
+void Checker::attributesOfImpl(const Instance& in, std::set<std::string>& out, int depth) const
+{
+  for (const AttributesSection& s : in.attributes)
+  {
+    collectAttributes(s, out);
+    for (const Use& u : s.uses)
+    {
+      const Instance* t = useTarget(u);
+      if (t && t != &in)
+      {
+        attributesOf(*t, out, depth + 1);
+      }
+    }
+  }
+  for (const CellsSection& c : in.cells)
+  {
+    for (const AttributesSection& s : c.attributes)
+    {
+      collectAttributes(s, out);
+    }
+  }
+  if (!in.base.text.empty())
+  {
+    const auto it = instances_.find(in.base.text);
+    if (it != instances_.end() && it->second != &in)
+    {
+      attributesOf(*it->second, out, depth + 1);
+    }
+  }
+}
+
+void Checker::attributes(const AttributesSection& s, const CellMap& cells, const Instance* in)
+{
+  std::set<std::string> known = globalAttributes_;
+  if (in)
+  {
+    attributesOf(*in, known, 0);
+  }
+  std::map<std::string, Pos> local;
+  const auto add = [&](const Name& n)
+  {
+    const auto it = local.find(n.text);
+    if (it != local.end())
+    {
+      err(n.pos,
+        "duplicate attribute '" + n.text + "' (first defined at " + lineOf(it->second) + ")");
+    }
+    local.emplace(n.text, n.pos);
+  };
+  for (const auto& b : s.bindings)
+  {
+    add(b.first);
+  }
+  for (const CellDef& d : s.defs)
+  {
+    add(d.name);
+    std::set<std::string> seen;
+    for (const Property& p : d.properties)
+    {
+      if (!seen.insert(p.name).second)
+      {
+        err(p.pos, "property '" + p.name + "' given twice");
+      }
+      if (p.name == "mapping" || p.name == "dim" || p.name == "priority" || p.name == "lifespan" ||
+        p.name == "timespan")
+      {
+        property(p, cells);
+      }
+      else
+      {
+        err(p.pos,
+          "unknown attribute property '" + p.name +
+            "': mapping, dim, lifespan, "
+            "priority or timespan");
+      }
+    }
+  }
+  for (const Use& u : s.uses)
+  {
+    use(u, "ATTRIBUTES", in);
+  }
+  if (!s.defaultAttribute.text.empty() && known.count(s.defaultAttribute.text) == 0)
+  {
+    err(s.defaultAttribute.pos, "undefined attribute '" + s.defaultAttribute.text + "'");
+  }
+  for (const Relation& r : s.links)
+  {
+    const ExprPtr& c = r.ends[0];
+    const Expr* root = c.get();
+    while (!root->kids.empty())
+    {
+      root = root->kids[0].get();
+    }
+    if (cells.count(root->text) == 0)
+    {
+      err(root->pos, "undefined cell '" + root->text + "'");
+    }
+    else if (c->kind == Expr::Kind::Member && c->text != "attributes")
+    {
+      err(c->pos, "an attribute link is 'Cell attr;' or 'Cell.attributes = attr;'");
+    }
+    if (known.count(r.ends[1]->text) == 0)
+    {
+      err(r.ends[1]->pos, "undefined attribute '" + r.ends[1]->text + "'");
+    }
+  }
+  reactionsOf(s.reactions, cells, in, nullptr);
+}
+
+} // namespace ictk::lang::icmcheck
