@@ -11,7 +11,7 @@
 // frame earlier than the engine's time starts the model again from its start, and so does any
 // frame after a cancelled or failed one (where the engine stopped is then an accident).
 //
-// The requested times of a T0:T1:DT range follow one rule, frameTimes() (the CLI's --time and the
+// The requested times of a T0:T1:DT range follow one rule, frameTimes() (the CLI's --frames and the
 // source's TimeStepSize both use it).
 
 #include "Complex/Complex.h"
