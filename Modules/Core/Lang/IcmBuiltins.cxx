@@ -107,31 +107,60 @@ std::string builtinsMarkdown()
   return out;
 }
 
-const std::vector<Signature>& shapeBuiltins()
+const std::vector<ShapeBuiltin>& shapeBuiltins()
 {
-  static const std::vector<Signature> table = {
-    { "file", 1, 1, "file(string path)  .hf or .xml (FRep), .obj or .off (mesh)", "shape" },
-    { "point", 3, 3, "point(real x, real y, real z)", "shape" },
-    { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" },
-    { "arc", 3, 3, "arc(vec3 p, vec3 q, real radius)", "shape" },
-    { "polyline", 2, -1, "polyline(vec3 p0, vec3 p1, ...)", "shape" },
-    { "rectangle", 2, 2, "rectangle(real width, real height)", "shape" },
-    { "disk", 1, 1, "disk(real radius)", "shape" },
-    { "box", 3, 3, "box(real sx, real sy, real sz)", "shape" },
-    { "sphere", 1, 1, "sphere(real radius)", "shape" },
-    { "blend", 3, 3, "blend(cellA, cellB, real amount)", "shape" },
-    { "union", 2, 2, "union(cellA, cellB)", "shape" },
-    { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" },
+  using Id = ShapeId;
+  static const std::vector<ShapeBuiltin> table = {
+    { Id::File, { "file", 1, 1, "file(string path)", "shape" }, 0,
+      "an FRep shape, `.hf` HyperFun or `.xml` FRep, relative to the model's folder (the checker "
+      "also accepts `.obj` and `.off` meshes, which the engine does not read yet)" },
+    { Id::Point, { "point", 3, 3, "point(real x, real y, real z)", "shape" }, 0, "a point" },
+    { Id::Segment, { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" }, 0,
+      "the segment from p to q" },
+    { Id::Arc, { "arc", 3, 3, "arc(vec3 p, vec3 q, real radius)", "shape" }, 0,
+      "counter-clockwise from p to q about the origin" },
+    { Id::CircularSegment,
+      { "circularSegment", 3, 3, "circularSegment(vec3 p, vec3 q, real radius)", "shape" }, 0,
+      "the region between that arc and its chord" },
+    { Id::Polyline, { "polyline", 2, -1, "polyline(vec3 p0, vec3 p1, ...)", "shape" }, 0,
+      "the open polyline through the points" },
+    { Id::Rectangle, { "rectangle", 2, 2, "rectangle(real width, real height)", "shape" }, 0,
+      "centred on the origin" },
+    { Id::Disk, { "disk", 1, 1, "disk(real radius)", "shape" }, 0, "centred on the origin" },
+    { Id::Box, { "box", 3, 3, "box(real sx, real sy, real sz)", "shape" }, 0,
+      "centred on the origin" },
+    { Id::Sphere, { "sphere", 1, 1, "sphere(real radius)", "shape" }, 0, "centred on the origin" },
+    { Id::Blend, { "blend", 3, 3, "blend(cellA, cellB, real amount)", "shape" }, 2,
+      "the blended union of two cells' shapes" },
+    { Id::Union, { "union", 2, 2, "union(cellA, cellB)", "shape" }, 2,
+      "the union of two cells' shapes" },
   };
   return table;
 }
 
-const Signature* findShapeBuiltin(const std::string& name)
+const ShapeBuiltin& shapeBuiltin(ShapeId id)
 {
-  for (const Signature& s : shapeBuiltins())
-    if (name == s.name)
-      return &s;
+  const ShapeBuiltin& b = shapeBuiltins().at(static_cast<std::size_t>(id));
+  if (b.id != id)
+    throw std::logic_error(
+      std::string("the table of shape constructors is out of order at ") + b.call.name);
+  return b;
+}
+
+const ShapeBuiltin* findShapeBuiltin(const std::string& name)
+{
+  for (const ShapeBuiltin& b : shapeBuiltins())
+    if (name == b.call.name)
+      return &b;
   return nullptr;
+}
+
+std::string shapeBuiltinsMarkdown()
+{
+  std::string out;
+  for (const ShapeBuiltin& b : shapeBuiltins())
+    out += std::string("| `") + b.call.signature + "` | " + b.doc + " |\n";
+  return out;
 }
 
 } // namespace ictk::lang::icm
