@@ -6,6 +6,27 @@
 namespace ictk::lang::icm
 {
 
+namespace
+{
+
+/// The entry called `name` of a table (built-ins, shape constructors); nullptr when none is.
+template <class Entry>
+const Entry* entryNamed(const std::vector<Entry>& table, const std::string& name)
+{
+  for (const Entry& e : table)
+    if (name == e.call.name)
+      return &e;
+  return nullptr;
+}
+
+/// A row of docs/icm.md: "| `signature` | what |".
+std::string row(const Signature& call, const std::string& what)
+{
+  return std::string("| `") + call.signature + "` | " + what + " |\n";
+}
+
+} // namespace
+
 const std::vector<Builtin>& builtins()
 {
   using Id = BuiltinId;
@@ -93,17 +114,14 @@ const Builtin& builtin(BuiltinId id)
 
 const Builtin* findBuiltin(const std::string& name)
 {
-  for (const Builtin& b : builtins())
-    if (name == b.call.name)
-      return &b;
-  return nullptr;
+  return entryNamed(builtins(), name);
 }
 
 std::string builtinsMarkdown()
 {
   std::string out;
   for (const Builtin& b : builtins())
-    out += std::string("| `") + b.call.signature + "` | " + b.call.result + ": " + b.doc + " |\n";
+    out += row(b.call, std::string(b.call.result) + ": " + b.doc);
   return out;
 }
 
@@ -138,28 +156,16 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
   return table;
 }
 
-const ShapeBuiltin& shapeBuiltin(ShapeId id)
-{
-  const ShapeBuiltin& b = shapeBuiltins().at(static_cast<std::size_t>(id));
-  if (b.id != id)
-    throw std::logic_error(
-      std::string("the table of shape constructors is out of order at ") + b.call.name);
-  return b;
-}
-
 const ShapeBuiltin* findShapeBuiltin(const std::string& name)
 {
-  for (const ShapeBuiltin& b : shapeBuiltins())
-    if (name == b.call.name)
-      return &b;
-  return nullptr;
+  return entryNamed(shapeBuiltins(), name);
 }
 
 std::string shapeBuiltinsMarkdown()
 {
   std::string out;
   for (const ShapeBuiltin& b : shapeBuiltins())
-    out += std::string("| `") + b.call.signature + "` | " + b.doc + " |\n";
+    out += row(b.call, b.doc);
   return out;
 }
 

@@ -127,7 +127,6 @@ struct ShapeBuiltin
 
 /// The shape constructors, indexed by ShapeId.
 const std::vector<ShapeBuiltin>& shapeBuiltins();
-const ShapeBuiltin& shapeBuiltin(ShapeId id);
 /// nullptr when `name` is not a shape constructor.
 const ShapeBuiltin* findShapeBuiltin(const std::string& name);
 /// The rows of docs/icm.md's table of shape constructors ("| `signature` | doc |"), one per entry.
