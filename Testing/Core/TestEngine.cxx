@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <string>
 
 namespace
@@ -476,7 +477,7 @@ TEST(EngineExemplars, OneRecordPerRequestedFrame)
 }
 
 // One table of built-ins (Lang/IcmBuiltins.h): the engine implements every entry once, in the
-// layer the entry names, and nothing else.
+// layer the entry names, and nothing else; likewise every shape constructor.
 TEST(EngineBuiltins, EveryEntryHasOneImplementation)
 {
   const std::vector<std::string> problems = ictk::engine::implementationProblems();
@@ -486,21 +487,24 @@ TEST(EngineBuiltins, EveryEntryHasOneImplementation)
   EXPECT_TRUE(problems.empty()) << all;
   EXPECT_EQ(ictk::engine::interpreterBuiltins().size() + ictk::engine::libraryBuiltins().size(),
     ictk::lang::icm::builtins().size());
+  EXPECT_EQ(ictk::engine::shapeConstructors().size(), ictk::lang::icm::shapeBuiltins().size());
 }
 
-// docs/icm.md's table of built-ins is the table's rendering (builtinsMarkdown): the rows after the
-// `<!-- builtins` marker, up to the first line that is not a row, header excluded.
-TEST(Docs, IcmBuiltins)
+namespace
+{
+
+/// The rows of docs/icm.md's table after the line that starts with `marker`, up to the first line
+/// that is not a row, header excluded; nullopt when there is no such marker.
+std::optional<std::string> icmDocTable(const std::string& marker)
 {
   std::ifstream in(std::string(ICTK_DATA_DIR) + "/../docs/icm.md");
-  ASSERT_TRUE(in) << "docs/icm.md";
   std::string line, rows;
-  bool marker = false, table = false;
+  bool found = false, table = false;
   while (std::getline(in, line))
   {
-    if (!marker)
+    if (!found)
     {
-      marker = line.rfind("<!-- builtins", 0) == 0;
+      found = line.rfind(marker, 0) == 0;
       continue;
     }
     if (line.rfind("|---", 0) == 0)
@@ -514,10 +518,29 @@ TEST(Docs, IcmBuiltins)
       break;
     rows += line + "\n";
   }
-  ASSERT_TRUE(marker) << "docs/icm.md has no <!-- builtins marker";
-  EXPECT_EQ(rows, ictk::lang::icm::builtinsMarkdown())
+  if (!found)
+    return std::nullopt;
+  return rows;
+}
+
+} // namespace
+
+// docs/icm.md's tables of built-ins and of shape constructors are the tables' renderings
+// (builtinsMarkdown, shapeBuiltinsMarkdown).
+TEST(Docs, IcmBuiltins)
+{
+  ASSERT_TRUE(std::ifstream(std::string(ICTK_DATA_DIR) + "/../docs/icm.md")) << "docs/icm.md";
+  const std::optional<std::string> builtins = icmDocTable("<!-- builtins");
+  ASSERT_TRUE(builtins) << "docs/icm.md has no <!-- builtins marker";
+  EXPECT_EQ(*builtins, ictk::lang::icm::builtinsMarkdown())
     << "docs/icm.md's built-ins differ from Lang/IcmBuiltins.cxx; the table's rows should be:\n"
     << ictk::lang::icm::builtinsMarkdown();
+  const std::optional<std::string> shapes = icmDocTable("<!-- shapes");
+  ASSERT_TRUE(shapes) << "docs/icm.md has no <!-- shapes marker";
+  EXPECT_EQ(*shapes, ictk::lang::icm::shapeBuiltinsMarkdown())
+    << "docs/icm.md's shape constructors differ from Lang/IcmBuiltins.cxx; the table's rows "
+       "should be:\n"
+    << ictk::lang::icm::shapeBuiltinsMarkdown();
 }
 
 // An instance's cells are its template's minus the removed plus the added, in the template's order

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // DynamicModel's public face over its state (ModelState.h): loading, the time range, the cells and
 // the complex of the active instance, the log and the evaluation order. Building is in
-// ModelBuild.cxx, values and placements in ModelValues.cxx, running in ModelRun.cxx, the library
-// calls of code in ModelLibrary.cxx.
+// ModelBuild.cxx and ModelShapes.cxx, values and placements in ModelValues.cxx, running in
+// ModelRun.cxx, the library calls of code in ModelLibrary.cxx.
 #include "Engine/DynamicModel.h"
 
 #include "Engine/ModelState.h"

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Building a running model from the checked syntax tree (ModelState.h): time spans, animation
-// curves, events, cells and their shapes, attributes, instances with the cells and relations they
-// derive, parameters, the dependency graph of an instance and the stepper with its reactions.
+// curves, events, cells (their shapes in ModelShapes.cxx), attributes, instances with the cells and
+// relations they derive, parameters, the dependency graph of an instance and the stepper with its
+// reactions.
 #include "Engine/ModelState.h"
-#include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 
 #include <algorithm>
@@ -340,150 +340,6 @@ void ModelState::buildCell(const CellDef& def)
     c.parts.clear();
   cellIndex[c.name] = cells.size();
   cells.push_back(std::move(c));
-}
-
-void ModelState::buildShape(CellSpec& c, const Property& p)
-{
-  c.parts.clear();
-  c.tape.reset();
-  c.operands.reset();
-  c.fieldPart = kNone;
-  auto addField = [&](const frep::Hypervolume& model, int parameterCount)
-  {
-    ShapePart part;
-    part.kind = ShapePart::Kind::Field;
-    part.fieldDimension = model.geometry().domain() == frep::Domain::XY ? 2 : 3;
-    c.tape = frep::Tape::compile(model.geometry().function());
-    c.parameterCount = parameterCount;
-    part.field = frep::tapeField(
-      c.tape, 0.0, std::vector<double>(static_cast<std::size_t>(parameterCount), 0.0));
-    part.bounds = c.domain;
-    c.fieldPart = c.parts.size();
-    c.parts.push_back(part);
-  };
-  if (p.isHyperFun)
-  {
-    try
-    {
-      const lang::HyperFunModel hf = lang::readHyperFun(p.hyperFunText, file);
-      addField(hf.model, hf.parameterCount);
-    }
-    catch (const lang::ParseError& e)
-    {
-      fail(p.hyperFunPos, std::string("in the hyperfun shape: ") + e.what());
-    }
-    return;
-  }
-  EngineScope scope(*this, {}, kNone);
-  for (const ExprPtr& v : p.values)
-  {
-    if (v->kind != Expr::Kind::Call)
-      fail(v->pos, "a shape is hyperfun { ... }, file(\"...\") or a constructor such as disk(r)");
-    const std::string& f = v->text;
-    std::vector<Value> args;
-    for (std::size_t i = 1; i < v->kids.size(); ++i)
-    {
-      const Expr& a = *v->kids[i];
-      if ((f == "blend" || f == "union") && i <= 2 && a.kind == Expr::Kind::Name)
-        args.push_back(Value::cell(a.text));
-      else
-        args.push_back(interpreter.evaluate(a, scope));
-    }
-    auto num = [&](std::size_t i)
-    {
-      if (i >= args.size() || !args[i].isNumber() || !std::isfinite(args[i].number))
-        fail(v->pos, f + ": argument " + std::to_string(i + 1) + " must be a finite number");
-      return args[i].number;
-    };
-    // Sizes, radii and blend amounts.
-    auto size = [&](std::size_t i)
-    {
-      const double x = num(i);
-      if (x < 0.0)
-        fail(v->pos, f + ": argument " + std::to_string(i + 1) + " must not be negative");
-      return x;
-    };
-    auto point = [&](std::size_t i)
-    {
-      if (i >= args.size() || args[i].type != Value::Type::Vec3)
-        fail(v->pos, f + ": argument " + std::to_string(i + 1) + " must be a point vec3(x, y, z)");
-      return args[i].vec;
-    };
-    ShapePart part;
-    if (f == "file")
-    {
-      if (args.empty() || args[0].type != Value::Type::String)
-        fail(v->pos, "file(\"name\") takes the file's name");
-      const std::string path = model.directory.empty() || args[0].text.rfind('/', 0) == 0
-        ? args[0].text
-        : model.directory + "/" + args[0].text;
-      const bool xml = path.size() > 4 && path.substr(path.size() - 4) == ".xml";
-      try
-      {
-        if (xml)
-          addField(lang::readFRepXmlFile(path), 0);
-        else
-        {
-          const lang::HyperFunModel hf = lang::readHyperFunFile(path);
-          addField(hf.model, hf.parameterCount);
-        }
-      }
-      catch (const std::exception& e)
-      {
-        fail(v->pos, "cannot read the shape file '" + path + "': " + e.what());
-      }
-      continue;
-    }
-    if (f == "point")
-    {
-      part.kind = ShapePart::Kind::Point;
-      part.points = { { num(0), num(1), args.size() > 2 ? num(2) : 0.0 } };
-    }
-    else if (f == "segment")
-    {
-      part.kind = ShapePart::Kind::Segment;
-      part.points = { point(0), point(1) };
-    }
-    else if (f == "polyline")
-    {
-      part.kind = ShapePart::Kind::Polyline;
-      for (std::size_t i = 0; i < args.size(); ++i)
-        part.points.push_back(point(i));
-    }
-    else if (f == "arc" || f == "circularSegment")
-    {
-      part.kind = f == "arc" ? ShapePart::Kind::Arc : ShapePart::Kind::CircularSegment;
-      part.points = { point(0), point(1) };
-      part.radius = size(2);
-    }
-    else if (f == "rectangle")
-    {
-      part.kind = ShapePart::Kind::Rectangle;
-      part.size = { size(0), size(1), 0.0 };
-    }
-    else if (f == "disk" || f == "sphere")
-    {
-      part.kind = f == "disk" ? ShapePart::Kind::Disk : ShapePart::Kind::Sphere;
-      part.radius = size(0);
-    }
-    else if (f == "box")
-    {
-      part.kind = ShapePart::Kind::Box;
-      part.size = { size(0), size(1), size(2) };
-    }
-    else if (f == "blend" || f == "union")
-    {
-      if (args.size() < 2 || args[0].type != Value::Type::Cell || args[1].type != Value::Type::Cell)
-        fail(v->pos, f + " takes two cells");
-      c.operands =
-        CellSpec::Operands{ f == "blend" ? ShapePart::Kind::Blend : ShapePart::Kind::Union,
-          args[0].text, args[1].text, f == "blend" ? size(2) : 0.0 };
-      continue;
-    }
-    else
-      fail(v->pos, "unknown shape constructor '" + f + "'");
-    c.parts.push_back(part);
-  }
 }
 
 RelationSpec ModelState::relationSpec(const Relation& r) const

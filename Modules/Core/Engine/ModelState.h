@@ -5,8 +5,9 @@
 // instances, relations, attributes, events, animation curves as specs), the parameter table and
 // the stepper, the structural state that rides in the stepper's snapshots, and the scope through
 // which the interpreter's code sees it all. Its members are defined by concern: building from the
-// syntax tree in ModelBuild.cxx, values, placements and the scope in ModelValues.cxx, running
-// (reactions, instances, frames) in ModelRun.cxx, the library calls of code in ModelLibrary.cxx.
+// syntax tree in ModelBuild.cxx (cells' shapes in ModelShapes.cxx), values, placements and the
+// scope in ModelValues.cxx, running (reactions, instances, frames) in ModelRun.cxx, the library
+// calls of code in ModelLibrary.cxx.
 
 #include "Dynamics/Animation.h"
 #include "Dynamics/Stepper.h"

@@ -16,6 +16,53 @@ bool opposite(double a, double b)
 }
 } // namespace
 
+GoldenSection goldenSection(
+  const std::function<double(double)>& f, double a, double b, const GoldenSectionOptions& o)
+{
+  auto key = [&](double v)
+  {
+    return o.magnitude ? std::abs(v) : v;
+  };
+  const double invPhi = (std::sqrt(5.0) - 1.0) / 2.0;
+  double x1 = b - invPhi * (b - a), x2 = a + invPhi * (b - a);
+  double f1 = f(x1), f2 = f(x2);
+  GoldenSection r;
+  r.evaluations = 2;
+  for (int it = 0; it < o.maxIterations &&
+       (b - a) > (o.relative ? o.tolerance * (1 + std::abs(a) + std::abs(b)) : o.tolerance);
+       ++it)
+  {
+    if (o.stop)
+    {
+      if (o.stop(x1, f1))
+        return { x1, f1, true, r.evaluations };
+      if (o.stop(x2, f2))
+        return { x2, f2, true, r.evaluations };
+    }
+    if (key(f1) <= key(f2))
+    {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - invPhi * (b - a);
+      f1 = f(x1);
+    }
+    else
+    {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + invPhi * (b - a);
+      f2 = f(x2);
+    }
+    ++r.evaluations;
+  }
+  const bool first = key(f1) <= key(f2);
+  r.x = first ? x1 : x2;
+  r.value = first ? f1 : f2;
+  return r;
+}
+
 double refineRoot(const std::function<double(double)>& g, double a, double ga, double b, double gb,
   const LocateOptions& o, int* evaluations)
 {
@@ -102,38 +149,23 @@ std::optional<Crossing> locateCrossing(
     if (i + 1 < n && std::abs(v[i + 1]) <= std::abs(v[i]) &&
       std::abs(v[i + 1]) <= std::abs(v[i + 2]) && !opposite(v[i + 1], v[i + 2]))
     {
-      // Golden-section search for min |g| on [s_i, s_i+2].
-      const double invPhi = (std::sqrt(5.0) - 1.0) / 2.0;
-      double a = s[i], b = s[i + 2];
-      double x1 = b - invPhi * (b - a), x2 = a + invPhi * (b - a);
-      double f1 = g(x1), f2 = g(x2);
-      evals += 2;
-      for (int it = 0; it < o.maxIterations && (b - a) > o.timeTolerance; ++it)
+      // Golden-section search for min |g| on [s_i, s_i+2]; a value of the other sign on the
+      // way is a bracket.
+      GoldenSectionOptions golden;
+      golden.maxIterations = o.maxIterations;
+      golden.tolerance = o.timeTolerance;
+      golden.relative = false;
+      golden.magnitude = true;
+      golden.stop = [&](double, double gx)
       {
-        if (opposite(f1, v[i]))
-          return signChange(s[i], v[i], x1, f1);
-        if (opposite(f2, v[i]))
-          return signChange(s[i], v[i], x2, f2);
-        if (std::abs(f1) <= std::abs(f2))
-        {
-          b = x2;
-          x2 = x1;
-          f2 = f1;
-          x1 = b - invPhi * (b - a);
-          f1 = g(x1);
-        }
-        else
-        {
-          a = x1;
-          x1 = x2;
-          f1 = f2;
-          x2 = a + invPhi * (b - a);
-          f2 = g(x2);
-        }
-        ++evals;
-      }
-      double tm = std::abs(f1) <= std::abs(f2) ? x1 : x2;
-      double gm = std::abs(f1) <= std::abs(f2) ? f1 : f2;
+        return opposite(gx, v[i]);
+      };
+      const GoldenSection m = goldenSection(g, s[i], s[i + 2], golden);
+      evals += m.evaluations;
+      if (m.stopped)
+        return signChange(s[i], v[i], m.x, m.value);
+      double tm = m.x;
+      double gm = m.value;
       // Near a tangency g ~ c (t - t*)^2 is flat below rounding within ~sqrt(eps) of t*, so the
       // golden section stops anywhere on that plateau. A parabola through g at tm - h, tm, tm + h
       // with h well above the plateau puts the vertex back on t* (exact for a quadratic g).

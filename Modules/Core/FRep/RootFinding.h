@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Roots of a scalar function of one variable: refineRoot() (Illinois) and locateCrossing()
-// (sampling, Illinois, golden section for touches). Numerics, not time or geometry, so it sits in
+// Roots of a scalar function of one variable: refineRoot() (Illinois), locateCrossing()
+// (sampling, Illinois, golden section for touches) and the golden-section minimiser
+// goldenSection() that locateCrossing and Geometry's nearest points share (Geometry/Curves.h
+// goldenMinimum). Numerics, not time or geometry, so it sits in
 // the kernel below both of its users: Dynamics locates transitions in time with it (issue 5:
 // "transitions located in time ... so that instantaneous states such as the tangency in thesis 5.1
 // are found, not skipped by a coarse step"), and Geometry refines meeting points along a curve's
@@ -60,6 +62,34 @@ struct Crossing
   double value = 0.0; ///< g(time)
   int evaluations = 0;
 };
+
+/// How goldenSection() searches.
+struct GoldenSectionOptions
+{
+  int maxIterations = 80;
+  /// The search stops once the bracket [a, b] is no wider than `tolerance`, or with `relative`
+  /// than tolerance * (1 + |a| + |b|).
+  double tolerance = 1e-15;
+  bool relative = true;
+  /// Minimise |f| instead of f (the values reported are still f's).
+  bool magnitude = false;
+  /// Asked of both inner points, (x, f(x)), before each step; true ends the search at that point
+  /// (locateCrossing stops where |g| is minimised as soon as g changes sign: a bracket).
+  std::function<bool(double, double)> stop;
+};
+
+/// The result of goldenSection().
+struct GoldenSection
+{
+  double x = 0.0;       ///< the inner point with the smaller value, or the one `stop` held at
+  double value = 0.0;   ///< f(x)
+  bool stopped = false; ///< `stop` held at x
+  int evaluations = 0;  ///< of f
+};
+
+/// A minimum of f (or of |f|) on [a, b] by golden-section search; f is assumed unimodal there.
+GoldenSection goldenSection(const std::function<double(double)>& f, double a, double b,
+  const GoldenSectionOptions& options = {});
 
 /// Refines a root of g in [a, b] where g(a) and g(b) have opposite signs (Illinois).
 double refineRoot(const std::function<double(double)>& g, double a, double ga, double b, double gb,

@@ -4,6 +4,7 @@
 // exact for points and segments and, for circles, exact up to the rounding of a golden-section
 // search on the exact point-circle distance.
 #include "Geometry/Curves.h"
+#include "FRep/RootFinding.h"
 
 #include <algorithm>
 #include <vector>
@@ -126,30 +127,11 @@ bool onExtent(const Piece& s, V2 x, double tol)
 double goldenMinimum(
   const std::function<double(double)>& f, double a, double b, double& tBest, double eps)
 {
-  const double g = 0.5 * (std::sqrt(5.0) - 1);
-  double c = b - g * (b - a), d = a + g * (b - a);
-  double fc = f(c), fd = f(d);
-  for (int i = 0; i < 80 && b - a > eps * (1 + std::abs(a) + std::abs(b)); ++i)
-  {
-    if (fc <= fd)
-    {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - g * (b - a);
-      fc = f(c);
-    }
-    else
-    {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + g * (b - a);
-      fd = f(d);
-    }
-  }
-  tBest = fc <= fd ? c : d;
-  return std::min(fc, fd);
+  frep::GoldenSectionOptions o;
+  o.tolerance = eps;
+  const frep::GoldenSection m = frep::goldenSection(f, a, b, o);
+  tBest = m.x;
+  return m.value;
 }
 
 V2 closestOnPiece(const Piece& s, V2 x)

@@ -113,7 +113,7 @@ double carrier(const Piece& s, V2 x, V2& grad);
 bool onExtent(const Piece& s, V2 x, double tol);
 
 /// The minimum of f over [a, b] by golden-section search (to eps relative to |a| + |b| + 1); its
-/// argument in tBest.
+/// argument in tBest. FRep's goldenSection (FRep/RootFinding.h), in the form the curves use.
 double goldenMinimum(
   const std::function<double(double)>& f, double a, double b, double& tBest, double eps = 1e-15);
 

@@ -6,6 +6,7 @@
 // sub-expression nested deeper than kMaxInlineDepth moves to <defs>, so that what is written
 // reads back under Limits::maxNesting.
 #include "Lang/FRepXml.h"
+#include "Lang/XmlText.h"
 
 #include <algorithm>
 #include <array>
@@ -49,48 +50,6 @@ std::string numberList(const std::vector<double>& values)
   return s;
 }
 
-std::string escapeAttribute(const std::string& value, const char* what)
-{
-  std::string s;
-  s.reserve(value.size());
-  for (char c : value)
-  {
-    switch (c)
-    {
-      case '&':
-        s += "&amp;";
-        break;
-      case '<':
-        s += "&lt;";
-        break;
-      case '>':
-        s += "&gt;";
-        break;
-      case '"':
-        s += "&quot;";
-        break;
-      // Character references, because a parser normalises literal white space in attributes.
-      case '\n':
-        s += "&#10;";
-        break;
-      case '\r':
-        s += "&#13;";
-        break;
-      case '\t':
-        s += "&#9;";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20)
-        {
-          throw std::invalid_argument(std::string("writeFRepXml: the ") + what +
-            " contains a control character, which XML 1.0 cannot carry");
-        }
-        s += c;
-    }
-  }
-  return s;
-}
-
 class XmlWriter
 {
 public:
@@ -109,7 +68,7 @@ public:
     parameterCount = std::max(parameterCount, static_cast<int>(maxSlot_ + 1));
 
     out_ += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    out_ += "<frep version=\"1\" name=\"" + escapeAttribute(name, "model name") +
+    out_ += "<frep version=\"1\" name=\"" + xmlAttribute(name, "writeFRepXml: the model name") +
       "\" parameters=\"" + std::to_string(parameterCount) + "\">\n";
     if (bounds)
     {
@@ -132,7 +91,7 @@ public:
     out_ += "  </geometry>\n";
     for (const frep::Attribute& a : hv.attributes())
     {
-      out_ += "  <attribute name=\"" + escapeAttribute(a.name, "attribute name") +
+      out_ += "  <attribute name=\"" + xmlAttribute(a.name, "writeFRepXml: the attribute name") +
         "\" components=\"" + std::to_string(a.components.size()) + "\" tensorRows=\"" +
         std::to_string(a.tensorRows) + "\">\n";
       out_ += "    <partition>\n";

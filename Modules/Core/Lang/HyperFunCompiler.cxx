@@ -517,6 +517,18 @@ void Compiler::assignScalar(Frame& f, const Statement& s, const Val& v)
   var.set.assign(1, 1);
 }
 
+Var& Compiler::declaredArray(Frame& f, const Statement& s, const std::string& size)
+{
+  auto it = f.vars.find(s.name);
+  if (it == f.vars.end() || !it->second.isArray)
+  {
+    fail(s.line, s.column,
+      "'" + s.spelling + "' is not a declared array (declare it with 'array " + s.spelling + "[" +
+        size + "];')");
+  }
+  return it->second;
+}
+
 void Compiler::executeOne(Frame& f, const Statement& s)
 {
   switch (s.kind)
@@ -573,16 +585,7 @@ void Compiler::executeOne(Frame& f, const Statement& s)
     }
     case Statement::Kind::AssignIndex:
     {
-      auto it = f.vars.find(s.name);
-      if (it == f.vars.end() || !it->second.isArray)
-      {
-        fail(s.line, s.column,
-          "'" + s.spelling +
-            "' is not a declared array (declare it with "
-            "'array " +
-            s.spelling + "[n];')");
-      }
-      const int i = indexOf(f, s.index, it->second, s.spelling);
+      const int i = indexOf(f, s.index, declaredArray(f, s, "n"), s.spelling);
       const Val v = eval(f, s.expr);
       Var& target = f.vars[s.name];
       target.items[static_cast<std::size_t>(i)] = v.e;
@@ -591,20 +594,12 @@ void Compiler::executeOne(Frame& f, const Statement& s)
     }
     case Statement::Kind::AssignList:
     {
-      auto it = f.vars.find(s.name);
-      if (it == f.vars.end() || !it->second.isArray)
-      {
-        fail(s.line, s.column,
-          "'" + s.spelling +
-            "' is not a declared array (declare it with "
-            "'array " +
-            s.spelling + "[" + std::to_string(s.list.size()) + "];')");
-      }
-      if (s.list.size() != it->second.items.size())
+      const Var& array = declaredArray(f, s, std::to_string(s.list.size()));
+      if (s.list.size() != array.items.size())
       {
         fail(s.line, s.column,
           "wrong number of items for '" + s.spelling + "': " + std::to_string(s.list.size()) +
-            " given, the array has " + std::to_string(it->second.items.size()));
+            " given, the array has " + std::to_string(array.items.size()));
       }
       std::vector<Expr> items;
       for (int e : s.list)

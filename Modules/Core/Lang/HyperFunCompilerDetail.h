@@ -174,6 +174,9 @@ private:
   // --- statements ----------------------------------------------------------------------------
   void execute(Frame& f, const std::vector<int>& body);
   void assignScalar(Frame& f, const Statement& s, const Val& v);
+  /// The array an item or list assignment `s` writes into; an error when it is none, whose hint
+  /// declares it with `size` items.
+  Var& declaredArray(Frame& f, const Statement& s, const std::string& size);
   void executeOne(Frame& f, const Statement& s);
   void executeIf(Frame& f, const Statement& s);
   void executeWhile(Frame& f, const Statement& s);

@@ -6,6 +6,27 @@
 namespace ictk::lang::icm
 {
 
+namespace
+{
+
+/// The entry called `name` of a table (built-ins, shape constructors); nullptr when none is.
+template <class Entry>
+const Entry* entryNamed(const std::vector<Entry>& table, const std::string& name)
+{
+  for (const Entry& e : table)
+    if (name == e.call.name)
+      return &e;
+  return nullptr;
+}
+
+/// A row of docs/icm.md: "| `signature` | what |".
+std::string row(const Signature& call, const std::string& what)
+{
+  return std::string("| `") + call.signature + "` | " + what + " |\n";
+}
+
+} // namespace
+
 const std::vector<Builtin>& builtins()
 {
   using Id = BuiltinId;
@@ -93,45 +114,59 @@ const Builtin& builtin(BuiltinId id)
 
 const Builtin* findBuiltin(const std::string& name)
 {
-  for (const Builtin& b : builtins())
-    if (name == b.call.name)
-      return &b;
-  return nullptr;
+  return entryNamed(builtins(), name);
 }
 
 std::string builtinsMarkdown()
 {
   std::string out;
   for (const Builtin& b : builtins())
-    out += std::string("| `") + b.call.signature + "` | " + b.call.result + ": " + b.doc + " |\n";
+    out += row(b.call, std::string(b.call.result) + ": " + b.doc);
   return out;
 }
 
-const std::vector<Signature>& shapeBuiltins()
+const std::vector<ShapeBuiltin>& shapeBuiltins()
 {
-  static const std::vector<Signature> table = {
-    { "file", 1, 1, "file(string path)  .hf or .xml (FRep), .obj or .off (mesh)", "shape" },
-    { "point", 3, 3, "point(real x, real y, real z)", "shape" },
-    { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" },
-    { "arc", 3, 3, "arc(vec3 p, vec3 q, real radius)", "shape" },
-    { "polyline", 2, -1, "polyline(vec3 p0, vec3 p1, ...)", "shape" },
-    { "rectangle", 2, 2, "rectangle(real width, real height)", "shape" },
-    { "disk", 1, 1, "disk(real radius)", "shape" },
-    { "box", 3, 3, "box(real sx, real sy, real sz)", "shape" },
-    { "sphere", 1, 1, "sphere(real radius)", "shape" },
-    { "blend", 3, 3, "blend(cellA, cellB, real amount)", "shape" },
-    { "union", 2, 2, "union(cellA, cellB)", "shape" },
-    { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" },
+  using Id = ShapeId;
+  static const std::vector<ShapeBuiltin> table = {
+    { Id::File, { "file", 1, 1, "file(string path)", "shape" }, 0,
+      "an FRep shape, `.hf` HyperFun or `.xml` FRep, relative to the model's folder (the checker "
+      "also accepts `.obj` and `.off` meshes, which the engine does not read yet)" },
+    { Id::Point, { "point", 3, 3, "point(real x, real y, real z)", "shape" }, 0, "a point" },
+    { Id::Segment, { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" }, 0,
+      "the segment from p to q" },
+    { Id::Arc, { "arc", 3, 3, "arc(vec3 p, vec3 q, real radius)", "shape" }, 0,
+      "counter-clockwise from p to q about the origin" },
+    { Id::CircularSegment,
+      { "circularSegment", 3, 3, "circularSegment(vec3 p, vec3 q, real radius)", "shape" }, 0,
+      "the region between that arc and its chord" },
+    { Id::Polyline, { "polyline", 2, -1, "polyline(vec3 p0, vec3 p1, ...)", "shape" }, 0,
+      "the open polyline through the points" },
+    { Id::Rectangle, { "rectangle", 2, 2, "rectangle(real width, real height)", "shape" }, 0,
+      "centred on the origin" },
+    { Id::Disk, { "disk", 1, 1, "disk(real radius)", "shape" }, 0, "centred on the origin" },
+    { Id::Box, { "box", 3, 3, "box(real sx, real sy, real sz)", "shape" }, 0,
+      "centred on the origin" },
+    { Id::Sphere, { "sphere", 1, 1, "sphere(real radius)", "shape" }, 0, "centred on the origin" },
+    { Id::Blend, { "blend", 3, 3, "blend(cellA, cellB, real amount)", "shape" }, 2,
+      "the blended union of two cells' shapes" },
+    { Id::Union, { "union", 2, 2, "union(cellA, cellB)", "shape" }, 2,
+      "the union of two cells' shapes" },
   };
   return table;
 }
 
-const Signature* findShapeBuiltin(const std::string& name)
+const ShapeBuiltin* findShapeBuiltin(const std::string& name)
 {
-  for (const Signature& s : shapeBuiltins())
-    if (name == s.name)
-      return &s;
-  return nullptr;
+  return entryNamed(shapeBuiltins(), name);
+}
+
+std::string shapeBuiltinsMarkdown()
+{
+  std::string out;
+  for (const ShapeBuiltin& b : shapeBuiltins())
+    out += row(b.call, b.doc);
+  return out;
 }
 
 } // namespace ictk::lang::icm

@@ -5,7 +5,8 @@
 // that computes it. Everything else comes from this table: the checker's signatures and argument
 // counts (IcmCheck), the engine's dispatch (the interpreter computes the pure math; the running
 // model computes the library calls: geometry between cells, events, animation curves, shapes of
-// T-cells), and the table of docs/icm.md, which a test compares with builtinsMarkdown().
+// T-cells), and the table of docs/icm.md, which a test compares with builtinsMarkdown(). The
+// constructors of a cell's `shape =` have a table of their own below, used the same way.
 //
 // The table lives here, below the engine, so that the checker needs no engine; the engine keeps
 // one implementation per BuiltinId and a test fails when an entry has no implementation or an
@@ -93,9 +94,42 @@ const Builtin* findBuiltin(const std::string& name);
 /// The rows of docs/icm.md's table of built-ins ("| `signature` | result: doc |"), one per entry.
 std::string builtinsMarkdown();
 
-/// The shape constructors allowed in a cell's `shape =` (computed when the model is built, not in
-/// code); nullptr when unknown.
-const Signature* findShapeBuiltin(const std::string& name);
-const std::vector<Signature>& shapeBuiltins();
+/// One per constructor of a cell's `shape =`, in the table's order.
+enum class ShapeId
+{
+  File,
+  Point,
+  Segment,
+  Arc,
+  CircularSegment,
+  Polyline,
+  Rectangle,
+  Disk,
+  Box,
+  Sphere,
+  Blend,
+  Union,
+  Count ///< not a constructor: the number of them
+};
+
+/// A constructor of a cell's `shape =`, computed when the model is built (not in code): the
+/// checker checks its arity and arguments, the engine builds it by id (Engine/Builtins.h checks
+/// that every entry has one builder) and docs/icm.md lists it (shapeBuiltinsMarkdown()).
+struct ShapeBuiltin
+{
+  ShapeId id;
+  Signature call;
+  /// How many leading arguments name cells (blend, union): the checker requires cell names there
+  /// and the engine passes them on as cells instead of evaluating them.
+  int cellArguments;
+  const char* doc; ///< one line for docs/icm.md
+};
+
+/// The shape constructors, indexed by ShapeId.
+const std::vector<ShapeBuiltin>& shapeBuiltins();
+/// nullptr when `name` is not a shape constructor.
+const ShapeBuiltin* findShapeBuiltin(const std::string& name);
+/// The rows of docs/icm.md's table of shape constructors ("| `signature` | doc |"), one per entry.
+std::string shapeBuiltinsMarkdown();
 
 } // namespace ictk::lang::icm

@@ -288,21 +288,22 @@ void Checker::shape(const ExprPtr& v, const CellMap& cells)
       "disk(r)");
     return;
   }
-  const Signature* b = findShapeBuiltin(v->text);
+  const ShapeBuiltin* shape = findShapeBuiltin(v->text);
   const int n = static_cast<int>(v->kids.size()) - 1;
-  if (!b)
+  if (!shape)
   {
     err(v->pos, "unknown shape constructor '" + v->text + "'");
     return;
   }
-  if (n < b->minArgs || (b->maxArgs >= 0 && n > b->maxArgs))
+  const Signature& b = shape->call;
+  if (n < b.minArgs || (b.maxArgs >= 0 && n > b.maxArgs))
   {
     err(v->pos,
-      "'" + v->text + "' takes " + arity(*b) + " argument(s) (" + b->signature + "), found " +
+      "'" + v->text + "' takes " + arity(b) + " argument(s) (" + b.signature + "), found " +
         std::to_string(n));
     return;
   }
-  if (v->text == "file")
+  if (shape->id == ShapeId::File)
   {
     const ExprPtr& a = v->kids[1];
     if (a->kind != Expr::Kind::String)
@@ -319,26 +320,19 @@ void Checker::shape(const ExprPtr& v, const CellMap& cells)
     }
     return;
   }
-  if (v->text == "blend" || v->text == "union")
+  // The leading arguments that name cells (blend, union), then constants.
+  const std::size_t cellArguments = static_cast<std::size_t>(shape->cellArguments);
+  for (std::size_t i = 1; i <= cellArguments; ++i)
   {
-    for (std::size_t i = 1; i <= 2; ++i)
+    const ExprPtr& a = v->kids[i];
+    if (a->kind != Expr::Kind::Name ||
+      (cells.count(a->text) == 0 && globalCells_.count(a->text) == 0))
     {
-      const ExprPtr& a = v->kids[i];
-      if (a->kind != Expr::Kind::Name ||
-        (cells.count(a->text) == 0 && globalCells_.count(a->text) == 0))
-      {
-        err(a->pos,
-          a->kind == Expr::Kind::Name ? "undefined cell '" + a->text + "'"
-                                      : "expected a cell name");
-      }
+      err(a->pos,
+        a->kind == Expr::Kind::Name ? "undefined cell '" + a->text + "'" : "expected a cell name");
     }
-    if (v->kids.size() > 3)
-    {
-      constant(v->kids[3]);
-    }
-    return;
   }
-  for (std::size_t i = 1; i < v->kids.size(); ++i)
+  for (std::size_t i = cellArguments + 1; i < v->kids.size(); ++i)
   {
     constant(v->kids[i]);
   }

@@ -3,6 +3,8 @@
 #include "ictkComplexSource.h"
 #include "ictkRequest.h"
 
+#include "Lang/XmlText.h"
+
 #include "vtkAbstractArray.h"
 #include "vtkAlgorithmOutput.h"
 #include "vtkCommand.h"
@@ -80,32 +82,6 @@ bool IsFrameEntry(const fs::directory_entry& entry, const std::string& stem)
   }
   return std::all_of(name.begin() + static_cast<std::ptrdiff_t>(prefix.size()), name.end(),
     [](unsigned char c) { return std::isdigit(c); });
-}
-
-std::string XmlAttribute(const std::string& s)
-{
-  std::string out;
-  for (char c : s)
-  {
-    switch (c)
-    {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
 }
 
 /// Where a series goes, checked before any frame is computed: the .pvd, its frames folder (named
@@ -402,7 +378,7 @@ int ictkTimeSeriesWriter::WriteSeries()
     }
     // The shortest text that reads back as the same double.
     pvd << "    <DataSet timestep=\"" << nlohmann::json(time).dump() << "\" file=\""
-        << XmlAttribute(out.Stem + "/" + name.str()) << "\"/>\n";
+        << ictk::lang::xmlAttribute(out.Stem + "/" + name.str(), "the frame file name") << "\"/>\n";
     this->FramesWritten = static_cast<int>(frame + 1);
     this->UpdateProgress(double(frame + 1) / double(frames));
     if (this->GetAbortExecute())

@@ -1,0 +1,238 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// A cell's `shape =` built into its parts (ModelState.h): inline HyperFun, or the shape
+// constructors of Lang/IcmBuiltins.h's table, one builder per entry in kShapes, found by the
+// table's id (Engine/Builtins.h checks that every entry has exactly one builder).
+#include "Engine/Builtins.h"
+#include "Engine/ModelState.h"
+#include "Lang/FRepXml.h"
+#include "Lang/HyperFun.h"
+
+#include <cmath>
+
+namespace ictk::engine
+{
+
+namespace
+{
+
+using lang::icm::ShapeId;
+
+/// A constructor's call in `shape =`: its evaluated arguments and the cell it builds into.
+struct ShapeCall
+{
+  ModelState& m;
+  CellSpec& c;
+  const Expr& expr;
+  const std::string& name;
+  const std::vector<Value>& args;
+
+  [[noreturn]] void fail(const std::string& message) const { m.fail(expr.pos, message); }
+  double num(std::size_t i) const
+  {
+    if (i >= args.size() || !args[i].isNumber() || !std::isfinite(args[i].number))
+      fail(name + ": argument " + std::to_string(i + 1) + " must be a finite number");
+    return args[i].number;
+  }
+  /// Sizes, radii and blend amounts.
+  double size(std::size_t i) const
+  {
+    const double x = num(i);
+    if (x < 0.0)
+      fail(name + ": argument " + std::to_string(i + 1) + " must not be negative");
+    return x;
+  }
+  Vec3 point(std::size_t i) const
+  {
+    if (i >= args.size() || args[i].type != Value::Type::Vec3)
+      fail(name + ": argument " + std::to_string(i + 1) + " must be a point vec3(x, y, z)");
+    return args[i].vec;
+  }
+  void add(ShapePart part) const { c.parts.push_back(std::move(part)); }
+};
+
+using ShapeConstructor = void (*)(const ShapeCall&);
+
+/// Makes a HyperFun or XML model the cell's field part, kept as a tape so that
+/// setShapeParameter can rebind its parameters.
+void addField(CellSpec& c, const frep::Hypervolume& model, int parameterCount)
+{
+  ShapePart part;
+  part.kind = ShapePart::Kind::Field;
+  part.fieldDimension = model.geometry().domain() == frep::Domain::XY ? 2 : 3;
+  c.tape = frep::Tape::compile(model.geometry().function());
+  c.parameterCount = parameterCount;
+  part.field = frep::tapeField(
+    c.tape, 0.0, std::vector<double>(static_cast<std::size_t>(parameterCount), 0.0));
+  part.bounds = c.domain;
+  c.fieldPart = c.parts.size();
+  c.parts.push_back(part);
+}
+
+void fileShape(const ShapeCall& s)
+{
+  if (s.args.empty() || s.args[0].type != Value::Type::String)
+    s.fail("file(\"name\") takes the file's name");
+  const std::string& directory = s.m.model.directory;
+  const std::string path = directory.empty() || s.args[0].text.rfind('/', 0) == 0
+    ? s.args[0].text
+    : directory + "/" + s.args[0].text;
+  const bool xml = path.size() > 4 && path.substr(path.size() - 4) == ".xml";
+  try
+  {
+    if (xml)
+      addField(s.c, lang::readFRepXmlFile(path), 0);
+    else
+    {
+      const lang::HyperFunModel hf = lang::readHyperFunFile(path);
+      addField(s.c, hf.model, hf.parameterCount);
+    }
+  }
+  catch (const std::exception& e)
+  {
+    s.fail("cannot read the shape file '" + path + "': " + e.what());
+  }
+}
+
+void pointShape(const ShapeCall& s)
+{
+  ShapePart part;
+  part.kind = ShapePart::Kind::Point;
+  part.points = { { s.num(0), s.num(1), s.args.size() > 2 ? s.num(2) : 0.0 } };
+  s.add(part);
+}
+
+void segmentShape(const ShapeCall& s)
+{
+  ShapePart part;
+  part.kind = ShapePart::Kind::Segment;
+  part.points = { s.point(0), s.point(1) };
+  s.add(part);
+}
+
+void polylineShape(const ShapeCall& s)
+{
+  ShapePart part;
+  part.kind = ShapePart::Kind::Polyline;
+  for (std::size_t i = 0; i < s.args.size(); ++i)
+    part.points.push_back(s.point(i));
+  s.add(part);
+}
+
+template <ShapePart::Kind kind>
+void arcShape(const ShapeCall& s)
+{
+  ShapePart part;
+  part.kind = kind;
+  part.points = { s.point(0), s.point(1) };
+  part.radius = s.size(2);
+  s.add(part);
+}
+
+void rectangleShape(const ShapeCall& s)
+{
+  ShapePart part;
+  part.kind = ShapePart::Kind::Rectangle;
+  part.size = { s.size(0), s.size(1), 0.0 };
+  s.add(part);
+}
+
+template <ShapePart::Kind kind>
+void roundShape(const ShapeCall& s)
+{
+  ShapePart part;
+  part.kind = kind;
+  part.radius = s.size(0);
+  s.add(part);
+}
+
+void boxShape(const ShapeCall& s)
+{
+  ShapePart part;
+  part.kind = ShapePart::Kind::Box;
+  part.size = { s.size(0), s.size(1), s.size(2) };
+  s.add(part);
+}
+
+/// blend(cellA, cellB, amount), union(cellA, cellB): the cell's shape is made of other cells'.
+template <ShapePart::Kind kind>
+void operandsShape(const ShapeCall& s)
+{
+  const std::vector<Value>& args = s.args;
+  if (args.size() < 2 || args[0].type != Value::Type::Cell || args[1].type != Value::Type::Cell)
+    s.fail(s.name + " takes two cells");
+  s.c.operands = CellSpec::Operands{ kind, args[0].text, args[1].text,
+    kind == ShapePart::Kind::Blend ? s.size(2) : 0.0 };
+}
+
+/// The engine's builders of the shape constructors (lang::icm::shapeBuiltins()).
+const std::pair<ShapeId, ShapeConstructor> kShapes[] = {
+  { ShapeId::File, fileShape },
+  { ShapeId::Point, pointShape },
+  { ShapeId::Segment, segmentShape },
+  { ShapeId::Arc, arcShape<ShapePart::Kind::Arc> },
+  { ShapeId::CircularSegment, arcShape<ShapePart::Kind::CircularSegment> },
+  { ShapeId::Polyline, polylineShape },
+  { ShapeId::Rectangle, rectangleShape },
+  { ShapeId::Disk, roundShape<ShapePart::Kind::Disk> },
+  { ShapeId::Box, boxShape },
+  { ShapeId::Sphere, roundShape<ShapePart::Kind::Sphere> },
+  { ShapeId::Blend, operandsShape<ShapePart::Kind::Blend> },
+  { ShapeId::Union, operandsShape<ShapePart::Kind::Union> },
+};
+
+} // namespace
+
+std::vector<ShapeId> shapeConstructors()
+{
+  return idsOf(kShapes);
+}
+
+void ModelState::buildShape(CellSpec& c, const Property& p)
+{
+  c.parts.clear();
+  c.tape.reset();
+  c.operands.reset();
+  c.fieldPart = kNone;
+  if (p.isHyperFun)
+  {
+    try
+    {
+      const lang::HyperFunModel hf = lang::readHyperFun(p.hyperFunText, file);
+      addField(c, hf.model, hf.parameterCount);
+    }
+    catch (const lang::ParseError& e)
+    {
+      fail(p.hyperFunPos, std::string("in the hyperfun shape: ") + e.what());
+    }
+    return;
+  }
+  EngineScope scope(*this, {}, kNone);
+  for (const ExprPtr& v : p.values)
+  {
+    if (v->kind != Expr::Kind::Call)
+      fail(v->pos, "a shape is hyperfun { ... }, file(\"...\") or a constructor such as disk(r)");
+    const std::string& f = v->text;
+    const lang::icm::ShapeBuiltin* shape = lang::icm::findShapeBuiltin(f);
+    // The leading arguments that name cells are passed on as cells (blend, union).
+    const std::size_t cellArguments = shape ? static_cast<std::size_t>(shape->cellArguments) : 0;
+    std::vector<Value> args;
+    for (std::size_t i = 1; i < v->kids.size(); ++i)
+    {
+      const Expr& a = *v->kids[i];
+      if (i <= cellArguments && a.kind == Expr::Kind::Name)
+        args.push_back(Value::cell(a.text));
+      else
+        args.push_back(interpreter.evaluate(a, scope));
+    }
+    ShapeConstructor build = nullptr;
+    if (shape)
+      for (const auto& [id, fn] : kShapes)
+        if (id == shape->id)
+          build = fn;
+    if (!build)
+      fail(v->pos, "unknown shape constructor '" + f + "'");
+    build(ShapeCall{ *this, c, *v, f, args });
+  }
+}
+
+} // namespace ictk::engine
