@@ -2,8 +2,8 @@
 #pragma once
 // Progress and cancellation, the same for every long operation of the core (sampling, meshing,
 // discretisation, tetrahedralisation, a dynamic model's run): OpenVDB's one-interrupter idea as a
-// callback. The operation calls progress(fraction) with fraction in [0, 1] from the thread that
-// called it; a false answer asks it to stop, and it then throws Cancelled, leaving what the caller
+// callback. The callback gets the done fraction in [0, 1], on the thread that called the
+// operation; a false answer asks it to stop, and it then throws Cancelled, leaving what the caller
 // passed in unchanged. The VTK layer maps it to UpdateProgress/AbortExecute
 // (Modules/VTK/Common/ictkRequest.h); the CLI to its progress display and Ctrl-C.
 //
@@ -40,10 +40,10 @@ public:
 /// called the operation (the calling thread), and alive for the whole call.
 ///
 /// Sequential work calls report(fraction). A nested operation gets range(lo, hi) in its option
-/// struct. A parallel loop takes items(count, lo, hi): its worker threads only poll cancelled()
-/// before an item and count it with finished() after; the calling thread, which works in the loop
-/// too, reports between its own items, and its report after the loop throws if the loop was
-/// cancelled. Cancelled is thrown only by report(), never inside a parallel loop's body.
+/// struct. A parallel loop takes items(count, lo, hi): every thread polls cancelled() before an
+/// item and counts it with finished() after; the calling thread, which works in the loop too,
+/// reports between its own items, and its report(hi) after the loop throws if the loop was
+/// cancelled. finished() never throws, so a loop's body needs no exception to stop.
 class ProgressScope
 {
 public:

@@ -177,6 +177,7 @@ public:
     Local& l = local();
     if ((++l.calls & 0xFFF) == 0)
     {
+      // Within a meshing step the phase stays: the report is the chance to stop.
       progress_.report(phase_);
     }
     const std::uint8_t* known = blockStates(p);
