@@ -336,15 +336,13 @@ ComplexMesh discretizeComplex(const Complex& complex, const DiscretizationOption
     }
     std::sort(ids.begin(), ids.end());
   }
+  ProgressScope progress(o.progress);
   std::size_t done = 0;
   for (CellId id : ids)
   {
     mesh.cells.push_back(discretizeCell(complex, id, o));
     ++done;
-    if (o.progress && !o.progress(0.9 * double(done) / double(ids.size())))
-    {
-      throw frep::Cancelled();
-    }
+    progress.report(0.9 * double(done) / double(ids.size()));
   }
   appendUnboundAttributes(complex, mesh, attributeTolerance, targets);
   if (!targets.empty())
@@ -354,10 +352,7 @@ ComplexMesh discretizeComplex(const Complex& complex, const DiscretizationOption
                        { return !std::binary_search(targets.begin(), targets.end(), m.cell); }),
       mesh.cells.end());
   }
-  if (o.progress && !o.progress(1.0))
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(1.0);
   return mesh;
 }
 

@@ -12,10 +12,8 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -138,15 +136,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
   const std::int64_t blockCount = blocks[0] * blocks[1] * blocks[2];
   std::vector<char> needsContour(static_cast<std::size_t>(blockCount), 0);
   std::vector<BlockOut> results(static_cast<std::size_t>(blockCount));
-  std::atomic<bool> cancelled{ false };
-  std::atomic<std::int64_t> done{ 0 };
-  auto report = [&](double fraction)
-  {
-    if (o.progress && !cancelled.load() && !o.progress(fraction))
-    {
-      cancelled = true;
-    }
-  };
+  ProgressScope progress(o.progress);
   auto blockRange =
     [&](std::int64_t b, std::array<std::int64_t, 3>& first, std::array<std::int64_t, 3>& extent)
   {
@@ -162,6 +152,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
   tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
 
   // Phase 1: labels of the grid points, sampled only in blocks the intervals cannot decide.
+  ProgressScope::Items labelled = progress.items(blockCount, 0, 0.4);
   arena.execute(
     [&]
     {
@@ -175,7 +166,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
           std::vector<char> out(solids.size()), in(solids.size());
           for (std::int64_t b = range.begin(); b != range.end(); ++b)
           {
-            if (cancelled.load())
+            if (progress.cancelled())
             {
               return;
             }
@@ -240,6 +231,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
                 }
               }
               needsContour[std::size_t(b)] = touchesBox && constant != 0;
+              labelled.finished();
               continue;
             }
             needsContour[std::size_t(b)] = 1;
@@ -313,20 +305,11 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
                 }
               }
             }
-            const std::int64_t finished = ++done;
-            if (o.progress && finished % 64 == 0)
-            {
-              static std::mutex progressMutex;
-              std::lock_guard<std::mutex> lock(progressMutex);
-              report(0.4 * double(finished) / double(blockCount));
-            }
+            labelled.finished();
           }
         });
     });
-  if (cancelled)
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(0.4);
 
   // Phase 2: triangles of the blocks with more than one label, as vertex keys.
   arena.execute(
@@ -348,11 +331,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
           }
         });
     });
-  report(0.5);
-  if (cancelled)
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(0.5);
 
   // Phase 3: the vertices, in ascending key order; positions by kind (edges, faces, centres).
   std::vector<VKey> keys;
@@ -368,11 +347,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
   MaterialSurface surface;
   surface.spacing = g.h;
   surface.points = placeVertices(keys, g, labels, rank, solids, arena);
-  report(0.8);
-  if (cancelled)
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(0.8);
 
   for (const auto& r : results)
   {
@@ -478,10 +453,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
       surface.regions.push_back({ regionPoint(pp), labels[p] });
     }
   }
-  if (o.progress && !o.progress(1.0))
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(1.0);
   return surface;
 }
 

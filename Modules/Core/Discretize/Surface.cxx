@@ -17,11 +17,9 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <memory>
-#include <thread>
 #include <vector>
 
 namespace ictk::discretize
@@ -167,13 +165,11 @@ SurfaceMesh contourSurface(
     std::unique_ptr<BlockContourer> contourer;
   };
   tbb::enumerable_thread_specific<ThreadState> states;
-  std::atomic<bool> cancelled{ false };
-  std::atomic<std::size_t> done{ 0 };
-  const std::thread::id caller = std::this_thread::get_id();
-  std::size_t lastReported = 0;
-  const std::size_t reportEvery = std::max<std::size_t>(1, tasks.size() / 100);
+  ProgressScope progress(options.progress);
   // Contouring is ~90% of the time; assembly the rest.
   constexpr double contourShare = 0.9;
+  ProgressScope::Items contoured =
+    progress.items(static_cast<std::int64_t>(tasks.size()), 0, contourShare);
 
   auto runTask = [&](std::size_t t)
   {
@@ -196,22 +192,12 @@ SurfaceMesh contourSurface(
   {
     for (std::size_t t = range.begin(); t != range.end(); ++t)
     {
-      if (cancelled.load(std::memory_order_relaxed))
+      if (progress.cancelled())
       {
         return;
       }
       runTask(t);
-      const std::size_t n = done.fetch_add(1) + 1;
-      if (options.progress && std::this_thread::get_id() == caller &&
-        n - lastReported >= reportEvery)
-      {
-        lastReported = n;
-        if (!options.progress(
-              contourShare * static_cast<double>(n) / static_cast<double>(tasks.size())))
-        {
-          cancelled = true;
-        }
-      }
+      contoured.finished();
     }
   };
 
@@ -221,10 +207,7 @@ SurfaceMesh contourSurface(
   auto run = [&]
   {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size(), 1), body);
-    if (cancelled)
-    {
-      return;
-    }
+    progress.report(contourShare);
     for (auto& list : taskBlocks)
     {
       for (auto& b : list)
@@ -288,14 +271,7 @@ SurfaceMesh contourSurface(
   {
     run();
   }
-  if (cancelled)
-  {
-    throw frep::Cancelled();
-  }
-  if (options.progress)
-  {
-    options.progress(1.0);
-  }
+  progress.report(1.0);
   return mesh;
 }
 

@@ -169,6 +169,7 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
   o.tolerance = options_.tolerance;
   o.threads = options_.threads;
 
+  ProgressScope progress(options_.progress);
   CoherenceStats frame;
   frame.frames = 1;
   std::vector<std::pair<std::string, CellWork>> work;
@@ -246,10 +247,7 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
       }
     }
     mesh.cells.back().cell = id;
-    if (options_.progress && !options_.progress(0.9 * double(i + 1) / double(ids.size())))
-    {
-      throw frep::Cancelled();
-    }
+    progress.report(0.9 * double(i + 1) / double(ids.size()));
   }
 
   // Attributes are functions of world position: evaluated where the points are now, never kept.
@@ -272,10 +270,7 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
                        { return !std::binary_search(targets.begin(), targets.end(), m.cell); }),
       mesh.cells.end());
   }
-  if (options_.progress && !options_.progress(1.0))
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(1.0);
   frame.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   last_ = frame;
   total_ += frame;

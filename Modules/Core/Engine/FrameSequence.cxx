@@ -58,20 +58,29 @@ struct FrameSequence::Impl
   /// The engine stands at a time between the requested ones: going on from there would give
   /// later frames one more stop than a run from the start, so the next later frame restarts.
   bool offGrid = false;
-  /// The span of the frame's progress that the engine's current advanceTo() fills.
-  double lo = 0;
-  double hi = 0.5;
+  /// During at(): where the engine's and the discretiser's reports go, the share of the frame's
+  /// progress that their current call fills; empty between frames.
+  Progress stage;
 
-  bool report(double fraction) const { return !options.progress || options.progress(fraction); }
+  /// A callback for the engine's or the discretiser's options that forwards to `stage`; empty
+  /// without a progress callback of the sequence, so that they report nothing.
+  Progress toStage()
+  {
+    if (!options.progress)
+    {
+      return {};
+    }
+    return [this](double fraction)
+    {
+      return !stage || stage(fraction);
+    };
+  }
 
   /// The model (again) at its start.
   void startModel()
   {
     RunOptions run = options.run;
-    run.progress = [this](double fraction)
-    {
-      return report(lo + (hi - lo) * fraction);
-    };
+    run.progress = toStage();
     model.reset();
     model.emplace(load(std::move(run)));
     pending.clear();
@@ -125,10 +134,7 @@ FrameSequence::FrameSequence(Loader load, FrameSequenceOptions options)
                                       : 1.0;
 
   CoherenceOptions discretization = in.options.discretization;
-  discretization.progress = [&in](double fraction)
-  {
-    return in.report(0.5 + 0.5 * fraction);
-  };
+  discretization.progress = in.toStage();
   in.mesher.emplace(std::move(discretization));
   if (!(in.options.discretization.featureSize > 0))
   {
@@ -175,6 +181,8 @@ Frame FrameSequence::at(double t, const CellShare& share)
 {
   Impl& in = *impl_;
   t = std::clamp(t, in.times.front(), in.times.back());
+  // The engine's run to t fills [0, 0.5] of the frame's progress, its discretisation [0.5, 1].
+  ProgressScope progress(in.options.progress);
   try
   {
     if (in.restart || t < in.model->time() || (in.offGrid && t != in.model->time()))
@@ -200,16 +208,14 @@ Frame FrameSequence::at(double t, const CellShare& share)
     }
     for (std::size_t i = 0; i < stops.size(); ++i)
     {
-      in.lo = 0.5 * double(i) / double(stops.size());
-      in.hi = 0.5 * double(i + 1) / double(stops.size());
+      in.stage = progress.range(
+        0.5 * double(i) / double(stops.size()), 0.5 * double(i + 1) / double(stops.size()));
       std::vector<FrameRecord> records = in.model->advanceTo(stops[i], in.maxStep);
       in.pending.insert(in.pending.end(), std::make_move_iterator(records.begin()),
         std::make_move_iterator(records.end()));
     }
-    if (!in.report(0.5))
-    {
-      throw Cancelled();
-    }
+    progress.report(0.5);
+    in.stage = progress.range(0.5, 1);
     in.offGrid = !std::binary_search(in.times.begin(), in.times.end(), t);
 
     Frame f;
@@ -240,11 +246,13 @@ Frame FrameSequence::at(double t, const CellShare& share)
     }
     f.records = std::move(in.pending);
     in.pending.clear();
-    in.report(1.0);
+    progress.report(1.0);
+    in.stage = nullptr;
     return f;
   }
   catch (...)
   {
+    in.stage = nullptr;
     in.restart = true;
     throw;
   }

@@ -277,6 +277,7 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
   if (!m.started)
     out.push_back(start());
   const double t0 = time();
+  ProgressScope progress(m.options.progress);
   while (time() < t)
   {
     const double now = time();
@@ -374,9 +375,9 @@ std::vector<FrameRecord> DynamicModel::advanceTo(double t, double maxStep)
         valid = m.validInstances(hi);
       }
     }
-    if (m.options.progress && t > t0 &&
-      !m.options.progress(std::min(1.0, (time() - t0) / (t - t0))))
-      throw Cancelled("the run was cancelled at t = " + std::to_string(time()));
+    if (t > t0)
+      progress.report(std::min(1.0, (time() - t0) / (t - t0)),
+        [&] { return "the run was cancelled at t = " + std::to_string(time()); });
   }
   return out;
 }

@@ -11,10 +11,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <sstream>
-#include <thread>
 
 namespace ictk::frep
 {
@@ -157,12 +155,9 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
   const std::int64_t brickCount = bricks[0] * bricks[1] * bricks[2];
 
   tbb::enumerable_thread_specific<std::optional<Workspace<T>>> workspaces;
-  std::atomic<std::int64_t> done{ 0 };
-  std::atomic<bool> cancelled{ false };
+  ProgressScope progress(options.progress);
+  ProgressScope::Items sampled = progress.items(brickCount, 0, 1);
   std::atomic<std::int64_t> statPoints{ 0 }, statInstructions{ 0 };
-  const std::thread::id caller = std::this_thread::get_id();
-  std::int64_t lastReported = -1;
-  const std::int64_t reportEvery = std::max<std::int64_t>(1, brickCount / 100);
 
   auto sampleBrick = [&](std::int64_t b)
   {
@@ -216,22 +211,12 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
   {
     for (std::int64_t b = range.begin(); b != range.end(); ++b)
     {
-      if (cancelled.load(std::memory_order_relaxed))
+      if (progress.cancelled())
       {
         return;
       }
       sampleBrick(b);
-      const std::int64_t n = done.fetch_add(1) + 1;
-      // Progress is reported only from the calling thread, as VTK and GUIs expect.
-      if (options.progress && std::this_thread::get_id() == caller &&
-        n - lastReported >= reportEvery)
-      {
-        lastReported = n;
-        if (!options.progress(static_cast<double>(n) / static_cast<double>(brickCount)))
-        {
-          cancelled = true;
-        }
-      }
+      sampled.finished();
     }
   };
   // Row evaluation and brick pruning are independent of which thread runs a brick, so the output
@@ -252,14 +237,7 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
     options.stats->pointsEvaluated = statPoints;
     options.stats->instructionEvaluations = statInstructions;
   }
-  if (cancelled)
-  {
-    throw Cancelled();
-  }
-  if (options.progress)
-  {
-    options.progress(1.0);
-  }
+  progress.report(1.0);
 }
 template <typename T>
 void sample(const TapePtr& tape, const Grid& grid, T* out, const SampleOptions& options)

@@ -155,10 +155,10 @@ class Labeller
 {
 public:
   Labeller(const std::vector<Solid>& solids, const Box3& domain, double overlapTolerance,
-    std::function<bool(double)> progress)
+    ProgressScope& progress)
     : solids_(solids)
     , tolerance_(overlapTolerance)
-    , progress_(std::move(progress))
+    , progress_(progress)
     , serial_(nextSerial())
   {
     order_.resize(solids_.size());
@@ -175,9 +175,10 @@ public:
   int label(const Point3& p)
   {
     Local& l = local();
-    if (progress_ && (++l.calls & 0xFFF) == 0 && !progress_(phase_))
+    if ((++l.calls & 0xFFF) == 0)
     {
-      throw frep::Cancelled();
+      // Within a meshing step the phase stays: the report is the chance to stop.
+      progress_.report(phase_);
     }
     const std::uint8_t* known = blockStates(p);
     int best = -1;
@@ -407,7 +408,7 @@ private:
   const std::vector<Solid>& solids_;
   std::vector<std::size_t> order_;
   double tolerance_;
-  std::function<bool(double)> progress_;
+  ProgressScope& progress_;
   double phase_ = 0;
   std::uint64_t serial_;
   Point3 gridLo_{ 0, 0, 0 };
@@ -1218,14 +1219,6 @@ void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& so
   }
 }
 
-void report(const TetraOptions& options, double fraction)
-{
-  if (options.progress && !options.progress(fraction))
-  {
-    throw frep::Cancelled();
-  }
-}
-
 } // namespace
 
 std::vector<std::vector<Point3>> cgalFeatureCurves(
@@ -1234,8 +1227,9 @@ std::vector<std::vector<Point3>> cgalFeatureCurves(
   checkOptions(options);
   const auto solids = collectSolids(complex);
   const Box3 box = domainBox(solids);
+  ProgressScope unreported{ Progress{} };
   Labeller labeller(
-    solids, padded(box, 0.02 * diagonal(box) + options.size), 1e-3 * options.size, {});
+    solids, padded(box, 0.02 * diagonal(box) + options.size), 1e-3 * options.size, unreported);
   const auto patches = collectPatches(complex, solids, labeller, options);
   return featureCurves(complex, solids, patches, box, options);
 }
@@ -1259,18 +1253,19 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
       << options.maxTetrahedra << ": use a larger size or raise maxTetrahedra";
     throw std::invalid_argument(s.str());
   }
-  report(options, 0);
+  ProgressScope progress(options.progress);
+  progress.report(0);
 
   const Box3 box = domainBox(solids);
   const double diag = diagonal(box);
   // The domain's box: a little larger than the cells' (so that faces on the cells' bounds are
   // seen as surfaces).
   const Box3 outer = padded(box, 0.02 * diag + options.size);
-  auto labeller = std::make_shared<Labeller>(solids, outer, 1e-3 * options.size, options.progress);
+  auto labeller = std::make_shared<Labeller>(solids, outer, 1e-3 * options.size, progress);
   checkOverlaps(solids, *labeller, options.size);
   const std::vector<Patch> patches = collectPatches(complex, solids, *labeller, options);
   const std::vector<Polyline> features = featureCurves(complex, solids, patches, box, options);
-  report(options, 0.1);
+  progress.report(0.1);
 
   // The domain: the label function, the outer box, bisection to 1e-10 of the diagonal.
   CGAL::Random rng(0);
@@ -1327,18 +1322,18 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
   }
   seedSurfaces(c3t3, domain, solids, *labeller, features, outer, h);
   CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::no_reset_c3t3());
-  report(options, 0.6);
+  progress.report(0.6);
   if (!options.deterministic)
   {
     labeller->setPhase(0.6);
     CGAL::perturb_mesh_3(
       c3t3, domain, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
-    report(options, 0.8);
+    progress.report(0.8);
   }
   labeller->setPhase(0.8);
   CGAL::exude_mesh_3(
     c3t3, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
-  report(options, 0.95);
+  progress.report(0.95);
 
   // Output: the tetrahedra of the complex, vertices numbered in order of first use.
   TetMesh mesh;
@@ -1407,7 +1402,7 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
       throw std::invalid_argument(s.str());
     }
   }
-  report(options, 1);
+  progress.report(1);
   return mesh;
 }
 

@@ -237,9 +237,10 @@ discretize::SurfaceMesh internalSurfaces(const complex::Complex& complex, Labels
 
 /// TetGen on the surface, with `internal` triangles as extra facets. A region no region point
 /// reaches (closed off by internal facets) takes the label `labelAt` gives most of its volume.
+/// Reports from 0.35 of the operation's progress on.
 TetMesh runTetGen(const discretize::MaterialSurface& surface, int materials,
   const discretize::SurfaceMesh* internal, const std::function<int(const Point3&)>& labelAt,
-  const TetraOptions& o, TetGenReport* report)
+  const TetraOptions& o, ProgressScope& progress, TetGenReport* report)
 {
   checkSize(o);
   if (surface.triangles.empty())
@@ -330,10 +331,7 @@ TetMesh runTetGen(const discretize::MaterialSurface& surface, int materials,
     report->surfaceTriangles = surface.triangles.size();
     report->internalTriangles = internal ? internal->triangles.size() : 0;
   }
-  if (o.progress && !o.progress(0.35))
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(0.35);
   const auto start = Clock::now();
   try
   {
@@ -436,10 +434,7 @@ TetMesh runTetGen(const discretize::MaterialSurface& surface, int materials,
   {
     mesh.materialNames.push_back("material " + std::to_string(m));
   }
-  if (o.progress && !o.progress(1.0))
-  {
-    throw frep::Cancelled();
-  }
+  progress.report(1.0);
   return mesh;
 }
 
@@ -448,7 +443,8 @@ TetMesh runTetGen(const discretize::MaterialSurface& surface, int materials,
 TetMesh tetrahedralizeSurfaceTetGen(const discretize::MaterialSurface& surface, int materials,
   const TetraOptions& o, TetGenReport* report)
 {
-  return runTetGen(surface, materials, nullptr, {}, o, report);
+  ProgressScope progress(o.progress);
+  return runTetGen(surface, materials, nullptr, {}, o, progress, report);
 }
 
 TetMesh tetrahedralizeTetGen(
@@ -504,13 +500,8 @@ TetMesh tetrahedralizeTetGen(
     checkBudget(estimateTetrahedra(labelledVolume(rough, materials), o.size), o);
   }
 
-  if (o.progress)
-  {
-    mo.progress = [&](double f)
-    {
-      return o.progress(0.3 * f);
-    };
-  }
+  ProgressScope progress(o.progress);
+  mo.progress = progress.range(0, 0.3);
   const auto start = Clock::now();
   const discretize::MaterialSurface surface =
     discretize::multiMaterialSurface(fields, priorities, box, o.size, mo);
@@ -545,7 +536,7 @@ TetMesh tetrahedralizeTetGen(
     internalSurfaces(complex, labels, o.size, 0.75 * o.size, o.threads, internalCells);
   TetMesh mesh = runTetGen(
     surface, materials, internal.triangles.empty() ? nullptr : &internal,
-    [&](const Point3& p) { return labels(p); }, o, report);
+    [&](const Point3& p) { return labels(p); }, o, progress, report);
   if (report)
   {
     report->surfaceSeconds = surfaceSeconds;
