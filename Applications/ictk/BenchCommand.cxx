@@ -20,7 +20,7 @@
 #include "BenchScaling.h"
 #include "Command.h"
 #include "Options.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 
 #include "Complex/Discretization.h"
 #include "Discretize/Surface.h"

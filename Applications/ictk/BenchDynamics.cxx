@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "BenchDynamics.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 
 #include "Engine/CoherentDiscretizer.h"
 #include "Engine/DynamicModel.h"

@@ -9,7 +9,7 @@
 // the contourer asks for. Pruned work should grow with the surface (r^2 in 3D, r in 2D), not with
 // the volume.
 #include "BenchScaling.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 
 #include "Discretize/Surface.h"
 #include "FRep/BundledModels.h"

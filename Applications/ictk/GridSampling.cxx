@@ -4,7 +4,7 @@
 #include "Command.h"
 #include "Options.h"
 #include "Output.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 #include "VtkMessages.h"
 
 #include "FRep/Evaluators.h"

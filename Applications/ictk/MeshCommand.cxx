@@ -7,7 +7,7 @@
 #include "Models.h"
 #include "Options.h"
 #include "Output.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 #include "VtkMessages.h"
 
 #include "ictkComplexSource.h"

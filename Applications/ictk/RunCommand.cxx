@@ -6,7 +6,7 @@
 // display, Ctrl-C and the summary.
 #include "Command.h"
 #include "Options.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 #include "VtkMessages.h"
 
 #include "Engine/DynamicModel.h"

@@ -5,7 +5,7 @@
 #include "GridSampling.h"
 #include "Options.h"
 #include "Output.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 #include "VtkMessages.h"
 
 #include <vtkImageData.h>

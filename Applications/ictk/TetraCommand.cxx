@@ -5,7 +5,7 @@
 #include "Models.h"
 #include "Options.h"
 #include "Output.h"
-#include "Progress.h"
+#include "ProgressDisplay.h"
 
 #include "Complex/Discretization.h"
 #include "FRep/Sampling.h"

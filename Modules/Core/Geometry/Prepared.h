@@ -6,7 +6,7 @@
 // interval arithmetic for the analytic parts, checks, the branch and bound over boxes, the local
 // searches of Distance.cxx). Each declaration says which file defines it.
 
-#include "Geometry/Curves.h"
+#include "Geometry/CurvePieces.h"
 #include "Geometry/PlacedShape.h"
 
 #include "FRep/Field.h"

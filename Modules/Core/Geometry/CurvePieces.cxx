@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The pieces of Curves.h: their carriers (the line, circle or ellipse a piece lies on, as a
+// The pieces of CurvePieces.h: their carriers (the line, circle or ellipse a piece lies on, as a
 // function that vanishes on it), nearest points and distances. Distances between pieces are
 // exact for points and segments and, for circles, exact up to the rounding of a golden-section
 // search on the exact point-circle distance.
-#include "Geometry/Curves.h"
+#include "Geometry/CurvePieces.h"
 #include "FRep/RootFinding.h"
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "Progress.h"
+#include "ProgressDisplay.h"
 
 #include <unistd.h>
 
