@@ -58,7 +58,10 @@ void addField(CellSpec& c, const frep::Hypervolume& model, int parameterCount)
 {
   ShapePart part;
   part.kind = ShapePart::Kind::Field;
-  part.fieldDimension = model.geometry().domain() == frep::Domain::XY ? 2 : 3;
+  const frep::Domain domain = model.geometry().domain();
+  // XYT is a 2D exemplar's space-time: its cross-sections lie in the plane.
+  part.fieldDimension = domain == frep::Domain::XY || domain == frep::Domain::XYT ? 2 : 3;
+  c.spaceTime = (frep::domainAxes(domain) & (1u << static_cast<int>(frep::Axis::T))) != 0;
   c.tape = frep::Tape::compile(model.geometry().function());
   c.parameterCount = parameterCount;
   part.field = frep::tapeField(
@@ -193,6 +196,7 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
   c.tape.reset();
   c.operands.reset();
   c.fieldPart = kNone;
+  c.spaceTime = false;
   if (p.isHyperFun)
   {
     try
