@@ -352,6 +352,11 @@ void ModelState::buildCell(const CellDef& def)
           "), so it is dim = " + std::to_string(expected) + "D, its cross-sections " +
           std::to_string(expected - 1) + "D");
   }
+  else if (std::any_of(c.parts.begin(), c.parts.end(),
+             [](const ShapePart& part) { return part.kind == ShapePart::Kind::Mesh; }) &&
+    c.dimension != 2)
+    fail(
+      dimPos, "the cell " + c.name + "'s shape is a mesh file, a triangle surface: it is dim = 2D");
   else if (c.dimension > 3)
     fail(dimPos,
       "the cell " + c.name +

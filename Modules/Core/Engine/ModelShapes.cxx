@@ -6,6 +6,7 @@
 #include "Engine/ModelState.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
+#include "Lang/MeshFile.h"
 
 #include <cmath>
 
@@ -82,7 +83,17 @@ void fileShape(const ShapeCall& s)
   const bool xml = path.size() > 4 && path.substr(path.size() - 4) == ".xml";
   try
   {
-    if (xml)
+    if (lang::isMeshFile(path))
+    {
+      // An explicit triangle surface in the cell's local coordinates (a B-cell, thesis loadMesh).
+      const complex::ExplicitGeometry mesh = lang::readMeshFile(path);
+      ShapePart part;
+      part.kind = ShapePart::Kind::Mesh;
+      part.points = mesh.points;
+      part.triangles = mesh.triangles;
+      s.add(std::move(part));
+    }
+    else if (xml)
       addField(s.c, lang::readFRepXmlFile(path), 0);
     else
     {
