@@ -24,7 +24,9 @@ namespace fs = std::filesystem;
 
 fs::path Folder()
 {
-  const fs::path dir = fs::temp_directory_path() / "ictk_engine_mesh_files";
+  // One folder per test: ctest runs the tests of this file in parallel processes.
+  const fs::path dir = fs::temp_directory_path() / "ictk_engine_mesh_files" /
+    ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::create_directories(dir);
   // A unit cube, six quads (two triangles each), with a comment and the counts on their own line.
   std::ofstream(dir / "cube.off") << "OFF\n# a unit cube\n8 6 12\n"
