@@ -546,10 +546,20 @@ def read_frame(path):
     return cells
 
 
+def pvd_frames(pvd, count, dt):
+    """The <DataSet>s of a .pvd written by ictk run, checked: `count` of them at 0, dt, 2 dt, ..."""
+    import xml.etree.ElementTree as ET
+    datasets = ET.parse(pvd).getroot().findall("./Collection/DataSet")
+    if len(datasets) != count:
+        sys.exit(f"FAIL: {len(datasets)} datasets in the .pvd, not {count}")
+    for k, d in enumerate(datasets):
+        near(float(d.get("timestep")), dt * k, 1e-12, f"time of dataset {k}")
+    return datasets
+
+
 def check_run_disk(ictk, work, data):
     """ictk run on thesis 5.1 (ch5_1_disk_rectangle.icm): the disk's centre is at x = -2 + t and
     touches the rectangle (left side x = 2) at t = 3: K1 before, K2 at the tangency, K3 after."""
-    import xml.etree.ElementTree as ET
     model = os.path.join(data, "Models", "icm", "ch5_1_disk_rectangle.icm")
     pvd = os.path.join(work, "disk.pvd")
     trace = os.path.join(work, "disk.jsonl")
@@ -564,11 +574,8 @@ def check_run_disk(ictk, work, data):
     if coherence["moved"] + coherence["reused"] == 0:
         sys.exit(f"FAIL: nothing reused across frames: {coherence}")
 
-    datasets = ET.parse(pvd).getroot().findall("./Collection/DataSet")
-    if len(datasets) != 13:
-        sys.exit(f"FAIL: {len(datasets)} datasets in the .pvd, not 13")
-    for k, d in enumerate(datasets):
-        near(float(d.get("timestep")), 0.5 * k, 1e-12, f"time of dataset {k}")
+    datasets = pvd_frames(pvd, 13, 0.5)
+    for d in datasets:
         if not os.path.isfile(os.path.join(work, d.get("file"))):
             sys.exit(f"FAIL: {d.get('file')} listed but not written")
     # t = 1 (K1: the rectangle and the disk) and t = 5 (K3: 7 cells), read back by VTK.
@@ -627,7 +634,6 @@ def check_run_default(ictk, work, data):
     100 steps: Andyhausen's film : TIMESPAN(0, 20) is 101 frames 0, 0.2, ..., 20, through its
     three instances (issue 16: it stopped at t = 10.346875). A model without a finite time span
     asks for --frames."""
-    import xml.etree.ElementTree as ET
     model = os.path.join(data, "Models", "icm", "andyhausen.icm")
     pvd = os.path.join(work, "andy.pvd")
     summary = json.loads(run(ictk, ["run", model, "-o", pvd, "--json"]).stdout)
@@ -640,11 +646,7 @@ def check_run_default(ictk, work, data):
     near(summary["transitions"][1]["time"], 6.346875, 1e-5, "egg under the surface")
     if summary["final_instance"] != "ANDY_OUT":
         sys.exit(f"FAIL: final instance {summary['final_instance']}")
-    datasets = ET.parse(pvd).getroot().findall("./Collection/DataSet")
-    if len(datasets) != 101:
-        sys.exit(f"FAIL: {len(datasets)} datasets in the .pvd, not 101")
-    for k, d in enumerate(datasets):
-        near(float(d.get("timestep")), 0.2 * k, 1e-12, f"time of dataset {k}")
+    datasets = pvd_frames(pvd, 101, 0.2)
     last = read_frame(os.path.join(work, datasets[-1].get("file")))
     if "Skeleton" not in last or {i for _, i in last.values()} != {"ANDY_OUT"}:
         sys.exit(f"FAIL: the frame t = 20: {sorted(last)}")
@@ -663,7 +665,6 @@ def check_run_space_time(ictk, work):
     at t = 0, 0.5, 1 are its cross-sections: spheres of diameter 1, 1.5 and 2 (issue 16: every
     frame was the t = 0 sphere)."""
     import vtk
-    import xml.etree.ElementTree as ET
     model = os.path.join(work, "growing.icm")
     with open(model, "w") as f:
         f.write("""name = GROWING;
@@ -680,9 +681,7 @@ K { CELLS { Ball; } }
 """)
     pvd = os.path.join(work, "growing.pvd")
     run(ictk, ["run", model, "--frames", "0:1:0.5", "--size", "0.03", "-o", pvd])
-    datasets = ET.parse(pvd).getroot().findall("./Collection/DataSet")
-    if len(datasets) != 3:
-        sys.exit(f"FAIL: {len(datasets)} frames, not 3")
+    datasets = pvd_frames(pvd, 3, 0.5)
     for d in datasets:
         t = float(d.get("timestep"))
         r = 0.5 + 0.5 * t
