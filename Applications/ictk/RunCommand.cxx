@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `ictk run`: runs a dynamic implicit complex (.icm) over a range of times and writes a .pvd time
-// series of its discretised complexes (one .vtpc per frame), optionally with a JSON-lines trace
-// of every evaluated time. The run is the dynamic complex source written by the time series
-// writer (Engine/FrameSequence.h is their one frame loop); this file adds the trace, the progress
-// display, Ctrl-C and the summary.
+// `ictk run`: runs a dynamic implicit complex (.icm) over a range of times (by default its time
+// spans' range in 100 steps) and writes a .pvd time series of its discretised complexes (one
+// .vtpc per frame), optionally with a JSON-lines trace of every evaluated time. The run is the
+// dynamic complex source written by the time series writer (Engine/FrameSequence.h is their one
+// frame loop); this file adds the trace, the progress display, Ctrl-C and the summary.
 #include "Command.h"
 #include "Options.h"
 #include "ProgressDisplay.h"
@@ -18,7 +18,9 @@
 #include <vtkCallbackCommand.h>
 #include <vtkCommand.h>
 #include <vtkExecutive.h>
+#include <vtkInformation.h>
 #include <vtkNew.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -183,7 +185,12 @@ struct Transition
 
 int RunModel(const RunModelOptions& o)
 {
-  const std::vector<double> times = ParseFrames(o.Frames, o.FramesOption);
+  // Without --frames, the source's default: the model's time range in 100 steps.
+  std::vector<double> times;
+  if (!o.Frames.empty())
+  {
+    times = ParseFrames(o.Frames, o.FramesOption);
+  }
   CheckSize(o.FeatureSize);
   if (!std::isfinite(o.MaxStep) || o.MaxStep < 0)
   {
@@ -200,13 +207,16 @@ int RunModel(const RunModelOptions& o)
   }
   TraceFile trace(o.Trace);
   const auto started = Clock::now();
-  const double maxStep = o.MaxStep > 0 ? o.MaxStep : times.size() > 1 ? times[1] - times[0] : 1.0;
+  double maxStep = o.MaxStep > 0 ? o.MaxStep : times.size() > 1 ? times[1] - times[0] : 0.0;
 
   // The run is the dynamic complex source (the engine's frames) written by the time series
   // writer; this command adds the trace, the progress display, Ctrl-C and the summary.
   vtkNew<ictkDynamicComplexSource> source;
   source->SetFileName(o.Model.c_str());
-  source->SetTimeSteps(times.data(), static_cast<int>(times.size()));
+  if (!times.empty())
+  {
+    source->SetTimeSteps(times.data(), static_cast<int>(times.size()));
+  }
   source->SetMaximumStep(maxStep);
   source->SetFeatureSize(o.FeatureSize);
   source->SetCoherent(!o.NoCoherence);
@@ -245,6 +255,22 @@ int RunModel(const RunModelOptions& o)
   if (!failure().empty())
   {
     throw std::runtime_error(failure());
+  }
+  if (times.empty())
+  {
+    vtkInformation* info = source->GetOutputInformation(0);
+    const double* steps = info->Get(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    times.assign(steps, steps + info->Length(vtkStreamingDemandDrivenPipeline::TIME_STEPS()));
+    if (times.size() < 2)
+    {
+      throw std::invalid_argument("the model's time spans give no time range to run (no "
+                                  "TIMESPAN with a finite start and end): give --frames T0:T1:DT");
+    }
+    // The engine's largest step is then the frames' spacing (FrameSequence's default).
+    for (std::size_t i = 1; o.MaxStep <= 0 && i < times.size(); ++i)
+    {
+      maxStep = i == 1 ? times[1] - times[0] : std::min(maxStep, times[i] - times[i - 1]);
+    }
   }
   if (times.front() < source->GetStartTime())
   {
@@ -456,8 +482,9 @@ public:
       "Run a dynamic implicit complex (.icm) and write its discretised complex at every frame as a "
       ".pvd time series (one .vtpc per frame)");
     AddModel(run, o.Model, "The .icm model");
-    this->FramesOption =
-      AddFrames(run, o.Frames, "Frames T0:T1:DT, e.g. 0:10:0.1 (T1 included); required");
+    this->FramesOption = AddFrames(run, o.Frames,
+      "Frames T0:T1:DT, e.g. 0:10:0.1 (T1 included); default: the model's time range (the "
+      "union of its time spans) in 100 steps");
     // The older spelling, from before --time meant an instant in every command.
     this->TimeOption = run->add_option("--time", o.Frames, "The same as --frames (older spelling)");
     this->FramesOption->excludes(this->TimeOption);
@@ -479,10 +506,6 @@ public:
 
   int run() override
   {
-    if (this->FramesOption->count() == 0 && this->TimeOption->count() == 0)
-    {
-      throw UserError("--frames is required (see ictk --help)");
-    }
     o.FramesOption = this->TimeOption->count() > 0 ? "--time" : "--frames";
     return RunModel(o);
   }

@@ -245,6 +245,34 @@ TEST(EngineExemplars, AndyhausenChainOrderAndInstances)
   EXPECT_EQ(m.activeInstance(), "ANDY_OUT");
 }
 
+// The whole film, 0..20 at 0.2 (issue 16: it stopped at t = 10.346875 with no valid instance,
+// ANDY_OUT's predicate being `localT < animationDuration("skeletonAnim")` with a 4 s animation).
+// The skeleton's animation now lasts 14 s (reach out in 4, pull out in 10 more), so ANDY_OUT
+// holds to the end: at t = 20 its local time is 20 - 6.346875 = 13.653125 and the skeleton,
+// 2 units up in the last 10 s, is at y = 0.5 + 2 x 9.653125 / 10 = 2.430625 in the hook's frame.
+TEST(EngineExemplars, AndyhausenRunsItsWholeFilm)
+{
+  DynamicModel m = load("andyhausen.icm");
+  EXPECT_EQ(m.timeRange(), std::make_pair(0.0, 20.0));
+  std::vector<std::string> instances;
+  std::size_t frames = 0;
+  for (int k = 0; k <= 100; ++k)
+  {
+    for (const FrameRecord& r : m.advanceTo(0.2 * k, 0.2))
+    {
+      if (instances.empty() || instances.back() != r.instance)
+        instances.push_back(r.instance);
+      frames += r.transition ? 0 : 1;
+    }
+  }
+  EXPECT_EQ(m.time(), 20.0);
+  EXPECT_EQ(frames, 100u); // t = 0.2 .. 20 (t = 0 is the start record, a transition)
+  EXPECT_EQ(instances, (std::vector<std::string>{ "EGG_GOING_DOWN", "EGG_ERODING", "ANDY_OUT" }));
+  EXPECT_EQ(m.activeInstance(), "ANDY_OUT");
+  EXPECT_NEAR(real(m, "Skeleton.translation.y"), 2.430625, 1e-4);
+  EXPECT_NEAR(real(m, "Skeleton.height"), 2.430625, 1e-4);
+}
+
 TEST(EngineExemplars, Deterministic)
 {
   auto run = []

@@ -546,10 +546,20 @@ def read_frame(path):
     return cells
 
 
+def pvd_frames(pvd, count, dt):
+    """The <DataSet>s of a .pvd written by ictk run, checked: `count` of them at 0, dt, 2 dt, ..."""
+    import xml.etree.ElementTree as ET
+    datasets = ET.parse(pvd).getroot().findall("./Collection/DataSet")
+    if len(datasets) != count:
+        sys.exit(f"FAIL: {len(datasets)} datasets in the .pvd, not {count}")
+    for k, d in enumerate(datasets):
+        near(float(d.get("timestep")), dt * k, 1e-12, f"time of dataset {k}")
+    return datasets
+
+
 def check_run_disk(ictk, work, data):
     """ictk run on thesis 5.1 (ch5_1_disk_rectangle.icm): the disk's centre is at x = -2 + t and
     touches the rectangle (left side x = 2) at t = 3: K1 before, K2 at the tangency, K3 after."""
-    import xml.etree.ElementTree as ET
     model = os.path.join(data, "Models", "icm", "ch5_1_disk_rectangle.icm")
     pvd = os.path.join(work, "disk.pvd")
     trace = os.path.join(work, "disk.jsonl")
@@ -564,11 +574,8 @@ def check_run_disk(ictk, work, data):
     if coherence["moved"] + coherence["reused"] == 0:
         sys.exit(f"FAIL: nothing reused across frames: {coherence}")
 
-    datasets = ET.parse(pvd).getroot().findall("./Collection/DataSet")
-    if len(datasets) != 13:
-        sys.exit(f"FAIL: {len(datasets)} datasets in the .pvd, not 13")
-    for k, d in enumerate(datasets):
-        near(float(d.get("timestep")), 0.5 * k, 1e-12, f"time of dataset {k}")
+    datasets = pvd_frames(pvd, 13, 0.5)
+    for d in datasets:
         if not os.path.isfile(os.path.join(work, d.get("file"))):
             sys.exit(f"FAIL: {d.get('file')} listed but not written")
     # t = 1 (K1: the rectangle and the disk) and t = 5 (K3: 7 cells), read back by VTK.
@@ -620,6 +627,75 @@ def check_run_disk(ictk, work, data):
     text = run(ictk, args).stdout
     if "13 frames" not in text or "2 transitions" not in text:
         sys.exit(f"FAIL: summary text:\n{text}")
+
+
+def check_run_default(ictk, work, data):
+    """ictk run without --frames runs the model's time range (the union of its time spans) in
+    100 steps: Andyhausen's film : TIMESPAN(0, 20) is 101 frames 0, 0.2, ..., 20, through its
+    three instances (issue 16: it stopped at t = 10.346875). A model without a finite time span
+    asks for --frames."""
+    model = os.path.join(data, "Models", "icm", "andyhausen.icm")
+    pvd = os.path.join(work, "andy.pvd")
+    summary = json.loads(run(ictk, ["run", model, "-o", pvd, "--json"]).stdout)
+    if summary["frames"] != 101 or summary["t0"] != 0 or summary["t1"] != 20:
+        sys.exit(f"FAIL: default frames {summary}")
+    near(summary["max_step"], 0.2, 1e-12, "default engine step")
+    if [t["to"] for t in summary["transitions"]] != ["EGG_ERODING", "ANDY_OUT"]:
+        sys.exit(f"FAIL: transitions {summary['transitions']}")
+    near(summary["transitions"][0]["time"], 3.0, 1e-6, "egg touches the liquid")
+    near(summary["transitions"][1]["time"], 6.346875, 1e-5, "egg under the surface")
+    if summary["final_instance"] != "ANDY_OUT":
+        sys.exit(f"FAIL: final instance {summary['final_instance']}")
+    datasets = pvd_frames(pvd, 101, 0.2)
+    last = read_frame(os.path.join(work, datasets[-1].get("file")))
+    if "Skeleton" not in last or {i for _, i in last.values()} != {"ANDY_OUT"}:
+        sys.exit(f"FAIL: the frame t = 20: {sorted(last)}")
+
+    forever = os.path.join(work, "forever.icm")
+    with open(forever, "w") as f:
+        f.write("name = FOREVER;\nTIMESPANS { always : TIMESPAN; }\n"
+                "CELLS { A { type = F-CELL; shape = disk(1); dim = 2D; } }\nK { CELLS { A; } }\n")
+    p = run(ictk, ["run", forever, "-o", os.path.join(work, "x.pvd")], check=False)
+    if p.returncode != 2 or "give --frames T0:T1:DT" not in p.stderr:
+        sys.exit(f"FAIL: no finite time span: exit {p.returncode}, stderr:\n{p.stderr}")
+
+
+def check_run_space_time(ictk, work):
+    """A 4D cell through ictk run: a sphere of radius 0.5 + 0.5 t (hyperfun x[4]), whose frames
+    at t = 0, 0.5, 1 are its cross-sections: spheres of diameter 1, 1.5 and 2 (issue 16: every
+    frame was the t = 0 sphere)."""
+    import vtk
+    model = os.path.join(work, "growing.icm")
+    with open(model, "w") as f:
+        f.write("""name = GROWING;
+TIMESPANS { film : TIMESPAN(0, 1); }
+CELLS {
+  Ball {
+    type = F-CELL;
+    shape = hyperfun { ball(x[4], a[1]) { ball = (0.5 + 0.5 * x[4])^2 - x[1]^2 - x[2]^2 - x[3]^2; } }
+    dim = 4D;
+    domain = { -1.2, -1.2, -1.2, 1.2, 1.2, 1.2 };
+  }
+}
+K { CELLS { Ball; } }
+""")
+    pvd = os.path.join(work, "growing.pvd")
+    run(ictk, ["run", model, "--frames", "0:1:0.5", "--size", "0.03", "-o", pvd])
+    datasets = pvd_frames(pvd, 3, 0.5)
+    for d in datasets:
+        t = float(d.get("timestep"))
+        r = 0.5 + 0.5 * t
+        leaf = read_frame(os.path.join(work, d.get("file")))["Ball"][0]
+        b = leaf.GetBounds()
+        for axis in range(3):
+            near(b[2 * axis + 1] - b[2 * axis], 2 * r, 0.03, f"diameter along axis {axis} at t = {t}")
+        mass = vtk.vtkMassProperties()
+        tri = vtk.vtkTriangleFilter()
+        tri.SetInputData(leaf)
+        mass.SetInputConnection(tri.GetOutputPort())
+        mass.Update()
+        near(mass.GetSurfaceArea(), 4 * math.pi * r * r, 0.02 * 4 * math.pi * r * r, f"area at t = {t}")
+        near(mass.GetVolume(), 4 / 3 * math.pi * r ** 3, 0.02 * 4 / 3 * math.pi * r ** 3, f"volume at t = {t}")
 
 
 def check_run_errors(ictk, work, data):
@@ -675,13 +751,15 @@ def main():
         "model-files": check_model_files,
         "bench": check_bench,
         "bench-scaling": check_bench_scaling,
+        "run-space-time": check_run_space_time,
     }
     if check == "tetra-bar":
         check_tetra_bar(ictk, work, rest[0])
         print("OK")
         return
-    if check in ("run-disk", "run-errors"):
-        (check_run_disk if check == "run-disk" else check_run_errors)(ictk, work, rest[0])
+    if check in ("run-disk", "run-errors", "run-default"):
+        {"run-disk": check_run_disk, "run-errors": check_run_errors,
+         "run-default": check_run_default}[check](ictk, work, rest[0])
         print("OK")
         return
     if check == "complex-flower":

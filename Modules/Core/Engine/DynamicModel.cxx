@@ -75,7 +75,7 @@ std::vector<CellState> DynamicModel::cells() const
     CellState st;
     st.name = n;
     st.kind = c.kind;
-    st.dimension = c.dimension;
+    st.dimension = m.spaceDimension(c);
     st.shape = m.shapeOf(n);
     st.shapeVersion = m.versionOf(n);
     out.push_back(std::move(st));
@@ -130,7 +130,8 @@ complex::Complex DynamicModel::complex() const
     local.place = m.place(cell);
     ShapePart part;
     part.kind = ShapePart::Kind::Field;
-    part.field = frep::tapeField(a->second.tape);
+    // An attribute of space and time (x[4]) follows the model's time, as space-time cells do.
+    part.field = frep::tapeField(a->second.tape, m.shapeTime());
     part.fieldDimension = a->second.dimension;
     // unbounded: the attribute is defined wherever its cell is
     part.bounds = frep::Box3{ { -1e30, -1e30, -1e30 }, { 1e30, 1e30, 1e30 } };

@@ -244,6 +244,7 @@ void ModelState::buildCell(const CellDef& def)
   }
   c.name = def.name.text;
   c.pos = def.pos;
+  Pos dimPos = def.pos;
   EngineScope scope(*this, {}, kNone);
   for (const Property& p : def.properties)
   {
@@ -263,7 +264,10 @@ void ModelState::buildCell(const CellDef& def)
       c.kind = k->second;
     }
     else if (p.name == "dim" && v)
+    {
       c.dimension = static_cast<int>(v->number);
+      dimPos = p.pos;
+    }
     else if (p.name == "domain")
     {
       std::vector<double> d;
@@ -334,6 +338,30 @@ void ModelState::buildCell(const CellDef& def)
         fail(def.pos, "the cell " + c.name + " has a field shape but no domain (its bounds)");
       part.bounds = c.domain;
     }
+  // A space-time cell (thesis 5.3) has one dimension more than its cross-sections: 4D for a
+  // field of x, y, z and t, 3D for one of x, y and t. Anything else declared 4D would be a 3D
+  // shape that no time moves, which is not what the model says.
+  if (c.spaceTime)
+  {
+    const int expected = c.parts[c.fieldPart].fieldDimension + 1;
+    if (c.dimension != expected)
+      fail(dimPos,
+        "the cell " + c.name + " has a space-time shape (" +
+          (expected == 4 ? "XYZT: hyperfun x[4] or an .xml of domain XYZT"
+                         : "XYT: an .xml of domain XYT") +
+          "), so it is dim = " + std::to_string(expected) + "D, its cross-sections " +
+          std::to_string(expected - 1) + "D");
+  }
+  else if (std::any_of(c.parts.begin(), c.parts.end(),
+             [](const ShapePart& part) { return part.kind == ShapePart::Kind::Mesh; }) &&
+    c.dimension != 2)
+    fail(
+      dimPos, "the cell " + c.name + "'s shape is a mesh file, a triangle surface: it is dim = 2D");
+  else if (c.dimension > 3)
+    fail(dimPos,
+      "the cell " + c.name +
+        " is dim = 4D, a space-time cell, but its shape is not a field of x, y, z and t "
+        "(hyperfun x[4], or an .xml of domain XYZT)");
   for (const Procedure& r : def.reactions)
     c.reactions[reactionKey(r)] = &r;
   if (c.operands && !c.parts.empty())
@@ -468,7 +496,8 @@ void ModelState::buildAttributes(const lang::icm::AttributesSection& section)
         {
           const lang::HyperFunModel hf = lang::readHyperFun(p.hyperFunText, file);
           a.tape = frep::Tape::compile(hf.model.geometry().function());
-          a.dimension = hf.model.geometry().domain() == frep::Domain::XY ? 2 : 3;
+          const frep::Domain domain = hf.model.geometry().domain();
+          a.dimension = domain == frep::Domain::XY || domain == frep::Domain::XYT ? 2 : 3;
           a.text = hf.name;
         }
         catch (const lang::ParseError& e)

@@ -6,6 +6,7 @@
 #include "Engine/ModelState.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
+#include "Lang/MeshFile.h"
 
 #include <cmath>
 
@@ -58,7 +59,10 @@ void addField(CellSpec& c, const frep::Hypervolume& model, int parameterCount)
 {
   ShapePart part;
   part.kind = ShapePart::Kind::Field;
-  part.fieldDimension = model.geometry().domain() == frep::Domain::XY ? 2 : 3;
+  const frep::Domain domain = model.geometry().domain();
+  // XYT is a 2D exemplar's space-time: its cross-sections lie in the plane.
+  part.fieldDimension = domain == frep::Domain::XY || domain == frep::Domain::XYT ? 2 : 3;
+  c.spaceTime = (frep::domainAxes(domain) & (1u << static_cast<int>(frep::Axis::T))) != 0;
   c.tape = frep::Tape::compile(model.geometry().function());
   c.parameterCount = parameterCount;
   part.field = frep::tapeField(
@@ -79,7 +83,17 @@ void fileShape(const ShapeCall& s)
   const bool xml = path.size() > 4 && path.substr(path.size() - 4) == ".xml";
   try
   {
-    if (xml)
+    if (lang::isMeshFile(path))
+    {
+      // An explicit triangle surface in the cell's local coordinates (a B-cell, thesis loadMesh).
+      const complex::ExplicitGeometry mesh = lang::readMeshFile(path);
+      ShapePart part;
+      part.kind = ShapePart::Kind::Mesh;
+      part.points = mesh.points;
+      part.triangles = mesh.triangles;
+      s.add(std::move(part));
+    }
+    else if (xml)
       addField(s.c, lang::readFRepXmlFile(path), 0);
     else
     {
@@ -193,6 +207,7 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
   c.tape.reset();
   c.operands.reset();
   c.fieldPart = kNone;
+  c.spaceTime = false;
   if (p.isHyperFun)
   {
     try

@@ -76,6 +76,10 @@ struct CellSpec
   frep::TapePtr tape;
   int parameterCount = 0;
   std::size_t fieldPart = kNone;
+  /// The field's domain has time (XYZT, or XYT for a 2D exemplar): the cell is a space-time
+  /// object (thesis 5.3, `dim = 4D` or `3D`) whose shape at global time t is its cross-section
+  /// there (makeCrossSection(shape, globalT)): the field with T bound to t.
+  bool spaceTime = false;
   /// blend(A, B, amount) / union(A, B): operands are cells, placed when the shape is needed.
   struct Operands
   {
@@ -213,6 +217,13 @@ struct ModelState
   void set(const std::string& q, const Value& v);
 
   // ---- shapes ----------------------------------------------------------------------------
+  /// The time shapes are evaluated at: the frame being evaluated, else the model's time.
+  double shapeTime() const { return context ? context->globalT : stepper ? stepper->time() : 0.0; }
+  /// The dimension of a cell's shape in space: a space-time cell's cross-section has one less.
+  int spaceDimension(const CellSpec& c) const
+  {
+    return c.spaceTime ? c.dimension - 1 : c.dimension;
+  }
   bool present(const std::string& cell) const
   {
     if (s.active == kNone)

@@ -121,9 +121,18 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
   if (auto it = s.shapes.find(c.name); it != s.shapes.end())
     return it->second;
   auto parts = std::make_shared<std::vector<ShapePart>>(c.parts);
-  if (c.fieldPart != kNone)
-    if (auto it = s.shapeParameters.find(c.name); it != s.shapeParameters.end())
-      (*parts)[c.fieldPart].field = frep::tapeField(c.tape, 0.0, it->second);
+  if (c.fieldPart == kNone)
+    return parts;
+  auto it = s.shapeParameters.find(c.name);
+  if (it != s.shapeParameters.end() || c.spaceTime)
+  {
+    // A space-time cell's cross-section at the model's time; the other fields have no time.
+    const std::vector<double> parameters = it != s.shapeParameters.end()
+      ? it->second
+      : std::vector<double>(static_cast<std::size_t>(c.parameterCount), 0.0);
+    (*parts)[c.fieldPart].field =
+      frep::tapeField(c.tape, c.spaceTime ? shapeTime() : 0.0, parameters);
+  }
   return parts;
 }
 
@@ -159,7 +168,7 @@ PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
   const CellSpec& c = cells[cellIndex.at(cell)];
   auto shape = std::make_shared<PlacedShape>();
   shape->cell = c.name;
-  shape->dimension = c.dimension;
+  shape->dimension = spaceDimension(c);
   shape->place = place(cell);
   if (c.operands && !s.shapes.count(cell))
   {
@@ -182,6 +191,9 @@ std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
   std::uint64_t v = 0;
   if (auto it = s.versions.find(cell); it != s.versions.end())
     v = it->second;
+  // A space-time cell's cross-section changes with time.
+  if (c.spaceTime)
+    v = mix(v, bitsOf(shapeTime()));
   if (!c.operands || s.shapes.count(cell) || depth > static_cast<int>(cells.size()))
     return v;
   // A blend or union lives in world coordinates: it changes when an operand moves.

@@ -29,6 +29,7 @@ int partDimension(const ShapePart& p)
     case ShapePart::Kind::CircularSegment:
     case ShapePart::Kind::Rectangle:
     case ShapePart::Kind::Disk:
+    case ShapePart::Kind::Mesh:
       return 2;
     case ShapePart::Kind::Box:
     case ShapePart::Kind::Sphere:
@@ -167,6 +168,22 @@ void validate(const PlacedShape& s, int depth)
         if (!finite3(p.bounds.lo) || !finite3(p.bounds.hi))
         {
           fail(s, "a field shape has non-finite bounds");
+        }
+        break;
+      case ShapePart::Kind::Mesh:
+        if (p.triangles.empty())
+        {
+          fail(s, "a mesh has no triangles");
+        }
+        for (const auto& t : p.triangles)
+        {
+          for (std::uint32_t i : t)
+          {
+            if (i >= p.points.size() || !finite3(p.points[i]))
+            {
+              fail(s, "a mesh triangle uses a missing or non-finite point");
+            }
+          }
         }
         break;
       case ShapePart::Kind::Blend:

@@ -16,6 +16,7 @@
 #include "FRep/Vector.h"
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,10 +66,14 @@ struct ShapePart
     Sphere,    ///< |p| <= radius                                                             3D
     Field,     ///< {field >= 0} (3D; 2D in z = 0 when fieldDimension == 2), inside `bounds`
     Blend,     ///< the blended union of two other cells' placed shapes (world coordinates)
-    Union      ///< the union of two other cells' placed shapes (world coordinates)
+    Union,     ///< the union of two other cells' placed shapes (world coordinates)
+    Mesh       ///< the triangle surface `triangles` over `points` (a .obj/.off B-cell)           2D
   };
   Kind kind = Kind::Point;
   std::vector<Vec3> points;
+  /// Mesh: corners of the triangles, indices into points. An explicit surface is discretised as
+  /// itself; the queries of Queries.h and worldField do not take it (they need a field).
+  std::vector<std::array<std::uint32_t, 3>> triangles;
   Vec3 size{ 0, 0, 0 };
   double radius = 0.0;
   frep::FieldPtr field; ///< Field: evaluated at local coordinates (z = 0 when 2D)

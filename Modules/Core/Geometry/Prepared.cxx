@@ -120,6 +120,10 @@ Prepared::Prepared(const PlacedShape& s)
       case ShapePart::Kind::Sphere:
         analytic = false;
         break;
+      case ShapePart::Kind::Mesh:
+        fail(s,
+          "is a mesh (a .obj or .off surface): the geometric queries, fields, blends and "
+          "unions do not take meshes");
       default:
         break;
     }

@@ -17,9 +17,43 @@ namespace ictk::geometry
 {
 using namespace detail;
 
+namespace
+{
+
+/// A shape of mesh parts (.obj/.off files) as the explicit surface it is: its triangles placed.
+complex::Cell meshCell(const PlacedShape& s)
+{
+  complex::ExplicitGeometry g;
+  for (const ShapePart& part : s.parts)
+  {
+    if (part.kind != ShapePart::Kind::Mesh)
+    {
+      fail(s, "a mesh is a shape of its own: it does not combine with other parts");
+    }
+    const auto offset = static_cast<std::uint32_t>(g.points.size());
+    for (const Vec3& q : part.points)
+    {
+      g.points.push_back(s.place.apply(q));
+    }
+    for (const auto& t : part.triangles)
+    {
+      g.triangles.push_back({ t[0] + offset, t[1] + offset, t[2] + offset });
+    }
+  }
+  complex::Cell cell = complex::explicitCell(s.cell, 2, std::move(g));
+  return cell;
+}
+
+} // namespace
+
 complex::Cell toComplexCell(const PlacedShape& s, complex::CellKind kind, const QueryOptions& o)
 {
   validate(s);
+  if (std::any_of(s.parts.begin(), s.parts.end(),
+        [](const ShapePart& part) { return part.kind == ShapePart::Kind::Mesh; }))
+  {
+    return meshCell(s);
+  }
   const Prepared p(s);
   complex::Cell cell;
   cell.name = s.cell;

@@ -13,7 +13,8 @@ namespace ictk::geometry
 /// The cell of an implicit complex that the placed shape stands for at this instant: implicit
 /// geometry for fields, disks, spheres, sectors, blends and unions (2D ones carried by z = 0);
 /// explicit points, polylines (arcs sampled with QueryOptions::arcSegments), triangles
-/// (rectangles) or tetrahedra (boxes). `kind` and the name/dimension are copied to the cell.
+/// (rectangles, and meshes: a B-cell surface of dimension 2) or tetrahedra (boxes). `kind` and the
+/// name/dimension are copied to the cell.
 complex::Cell toComplexCell(
   const PlacedShape& s, complex::CellKind kind, const QueryOptions& o = {});
 

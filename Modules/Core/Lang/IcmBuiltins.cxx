@@ -130,8 +130,9 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
   using Id = ShapeId;
   static const std::vector<ShapeBuiltin> table = {
     { Id::File, { "file", 1, 1, "file(string path)", "shape" }, 0,
-      "an FRep shape, `.hf` HyperFun or `.xml` FRep, relative to the model's folder (the checker "
-      "also accepts `.obj` and `.off` meshes, which the engine does not read yet)" },
+      "relative to the model's folder: an FRep shape, `.hf` HyperFun or `.xml` FRep; or a "
+      "triangle mesh, `.obj` or `.off` (a B-cell surface, `dim = 2D`, placed by the cell; the "
+      "queries, `blend` and `union` do not take it)" },
     { Id::Point, { "point", 3, 3, "point(real x, real y, real z)", "shape" }, 0, "a point" },
     { Id::Segment, { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" }, 0,
       "the segment from p to q" },

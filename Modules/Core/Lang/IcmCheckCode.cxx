@@ -726,6 +726,14 @@ Ty Checker::call(const Expr& e, Code& c)
     {
       err(e.kids[i]->pos, "argument " + std::to_string(i) + " of '" + fn + "' is a cell name");
     }
+    else if (cellArgs == 2 && i <= cellArgs && e.kids[i]->kind == Expr::Kind::Name &&
+      isMeshCell(e.kids[i]->text, c.cells))
+    {
+      // The queries work on fields and analytic shapes; an explicit surface has neither.
+      err(e.kids[i]->pos,
+        "'" + fn + "' does not take meshes yet, and cell '" + e.kids[i]->text +
+          "' is a mesh (.obj/.off)");
+    }
     else if (i > cellArgs && t == Ty::Cell)
     {
       err(e.kids[i]->pos,

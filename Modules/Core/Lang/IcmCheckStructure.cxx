@@ -2,6 +2,7 @@
 // The checks of a model's structure: cells (their sources, properties, parameters and shapes) and
 // attributes.
 #include "Lang/IcmChecker.h"
+#include "Lang/MeshFile.h"
 
 namespace ictk::lang::icmcheck
 {
@@ -320,6 +321,18 @@ void Checker::shape(const ExprPtr& v, const CellMap& cells)
     }
     return;
   }
+  if (shape->id == ShapeId::Blend || shape->id == ShapeId::Union)
+  {
+    for (std::size_t i = 1; i < v->kids.size() && i <= 2; ++i)
+    {
+      const ExprPtr& a = v->kids[i];
+      if (a->kind == Expr::Kind::Name && isMeshCell(a->text, &cells))
+      {
+        err(a->pos,
+          "'" + v->text + "' takes fields, and cell '" + a->text + "' is a mesh (.obj/.off)");
+      }
+    }
+  }
   // The leading arguments that name cells (blend, union), then constants.
   const std::size_t cellArguments = static_cast<std::size_t>(shape->cellArguments);
   for (std::size_t i = 1; i <= cellArguments; ++i)
@@ -336,6 +349,38 @@ void Checker::shape(const ExprPtr& v, const CellMap& cells)
   {
     constant(v->kids[i]);
   }
+}
+
+bool Checker::isMeshCell(const std::string& name, const CellMap* cells, int depth) const
+{
+  const CellDef* def = nullptr;
+  if (cells && cells->count(name))
+  {
+    def = cells->at(name);
+  }
+  else if (globalCells_.count(name))
+  {
+    def = globalCells_.at(name);
+  }
+  if (!def || depth > 64)
+  {
+    return false;
+  }
+  const Property* p = def->property("shape");
+  if (!p)
+  {
+    // A copy `B <- A` has A's shape unless it gives its own.
+    return !def->source.text.empty() && isMeshCell(def->source.text, cells, depth + 1);
+  }
+  for (const ExprPtr& v : p->values)
+  {
+    if (v->kind == Expr::Kind::Call && v->text == "file" && v->kids.size() == 2 &&
+      v->kids[1]->kind == Expr::Kind::String && isMeshFile(v->kids[1]->text))
+    {
+      return true;
+    }
+  }
+  return false;
 }
 
 std::string Checker::arity(const Signature& b)

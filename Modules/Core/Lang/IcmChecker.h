@@ -147,6 +147,9 @@ private:
   // Compiles an inline HyperFun shape; its errors are placed in the model text.
   void hyperFun(const Property& p);
   void shape(const ExprPtr& v, const CellMap& cells);
+  /// Whether the named cell's shape is a mesh file (file("*.obj" or "*.off")): an explicit surface
+  /// that the geometric queries, blends and unions do not take.
+  bool isMeshCell(const std::string& name, const CellMap* cells, int depth = 0) const;
   static std::string arity(const Signature& b);
 
   // ---- attributes -------------------------------------------------------------------------------

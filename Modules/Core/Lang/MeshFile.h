@@ -1,0 +1,25 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// Triangle meshes from .obj (Wavefront) and .off (Object File Format) files: the explicit
+// surfaces that a .icm cell's `shape = file("handle.obj")` stands for (a B-cell, thesis
+// loadMesh). Only what a surface needs is read: vertices and faces, each face of n >= 3 corners
+// triangulated as a fan from its first corner; normals, texture coordinates, groups and
+// materials are skipped. VTK-free, so the engine reads them without the VTK layer.
+
+#include "Complex/Cell.h"
+
+#include <string>
+
+namespace ictk::lang
+{
+
+/// True for paths ending in .obj or .off (case-insensitive): the mesh files `file(...)` reads.
+bool isMeshFile(const std::string& path);
+
+/// The file's points and triangles (ExplicitGeometry's points and triangles; no polylines or
+/// tetrahedra). Throws ParseError naming the file and line: an unreadable file, a malformed number
+/// or count, a face of fewer than three corners, an index out of range (.obj's 1-based and
+/// negative indices are both read), no faces at all.
+complex::ExplicitGeometry readMeshFile(const std::string& path);
+
+} // namespace ictk::lang
