@@ -138,6 +138,9 @@ struct Workspace
   std::optional<frep::HypervolumeEvaluator> attributes;
   std::vector<double> attributeValues;
   std::vector<std::uint8_t> done; // the current tile's pixels that found their surface
+  /// Per pixel of the tile: the depth of the first piece that was left unresolved (NaN: none).
+  std::vector<double> unresolvedAt;
+  Stage* root = nullptr; // the full tape's stage of the current tile
   Rect tile{ 0, 0, 0, 0 };
   std::int64_t intervals = 0, points = 0, covered = 0, unresolved = 0;
 };
@@ -258,23 +261,56 @@ private:
   void castTile(Workspace& ws, const Rect& tile)
   {
     ws.tile = tile;
-    ws.done.assign(static_cast<std::size_t>(tile.i1 - tile.i0) * (tile.j1 - tile.j0), 0);
+    const std::size_t pixels = static_cast<std::size_t>(tile.i1 - tile.i0) * (tile.j1 - tile.j0);
+    ws.done.assign(pixels, 0);
+    ws.unresolvedAt.assign(pixels, std::numeric_limits<double>::quiet_NaN());
     if (!(far_ > near_))
     {
       return; // the box is behind the camera
     }
     Stage root(tape_, options_.parameters, &ws.interval);
+    ws.root = &root;
     node(ws, root, tile, near_, far_);
+    // Rays that left a piece unresolved and found nothing behind it within a leaf.
+    for (int j = tile.j0; j < tile.j1; ++j)
+    {
+      for (int i = tile.i0; i < tile.i1; ++i)
+      {
+        const double u = unresolvedAt(ws, i, j);
+        if (!done(ws, i, j) && !std::isnan(u))
+        {
+          const Ray ray = rayOf(i, j);
+          hit(ws, root, ray, u, u, true);
+        }
+      }
+    }
+    ws.root = nullptr;
   }
 
-  std::uint8_t& done(Workspace& ws, int i, int j) const
+  Ray rayOf(int i, int j) const
   {
-    const int width = ws.tile.i1 - ws.tile.i0;
-    return ws.done[static_cast<std::size_t>(j - ws.tile.j0) * width + (i - ws.tile.i0)];
+    Ray ray;
+    ray.i = i;
+    ray.j = j;
+    const double u = camera_.u(i), v = camera_.v(j);
+    ray.origin = camera_.origin(u, v);
+    ray.direction = camera_.direction(u, v);
+    ray.length = frep::norm(ray.direction);
+    return ray;
+  }
+
+  static std::size_t inTile(const Workspace& ws, int i, int j)
+  {
+    return static_cast<std::size_t>(j - ws.tile.j0) * (ws.tile.i1 - ws.tile.i0) + (i - ws.tile.i0);
+  }
+  std::uint8_t& done(Workspace& ws, int i, int j) const { return ws.done[inTile(ws, i, j)]; }
+  double& unresolvedAt(Workspace& ws, int i, int j) const
+  {
+    return ws.unresolvedAt[inTile(ws, i, j)];
   }
 
   /// The smallest rectangle that holds the pixels of `r` still to be found; false if none.
-  bool pending(Workspace& ws, Rect& r) const
+  bool remaining(Workspace& ws, Rect& r) const
   {
     Rect p{ r.i1, r.j1, r.i0, r.j0 };
     for (int j = r.j0; j < r.j1; ++j)
@@ -348,7 +384,7 @@ private:
   /// A rectangle of pixels between two depths (step 2 of the header's algorithm).
   void node(Workspace& ws, Stage& stage, Rect r, double s0, double s1)
   {
-    if (!pending(ws, r))
+    if (!remaining(ws, r))
     {
       return;
     }
@@ -391,13 +427,7 @@ private:
   /// One pixel's ray between two depths, clipped to the model's box (step 3).
   void pixel(Workspace& ws, Stage& stage, int i, int j, double s0, double s1)
   {
-    Ray ray;
-    ray.i = i;
-    ray.j = j;
-    const double u = camera_.u(i), v = camera_.v(j);
-    ray.origin = camera_.origin(u, v);
-    ray.direction = camera_.direction(u, v);
-    ray.length = frep::norm(ray.direction);
+    Ray ray = rayOf(i, j);
     for (int a = 0; a < 3; ++a)
     {
       const double o = ray.origin[a], d = ray.direction[a];
@@ -426,6 +456,12 @@ private:
 
   bool segment(Workspace& ws, Stage& stage, Ray& ray, double a, double b)
   {
+    const double u = unresolvedAt(ws, ray.i, ray.j);
+    if (!std::isnan(u) && (a - u) * ray.length > footprint(u))
+    {
+      hit(ws, *ws.root, ray, u, u, true); // nothing was found within a leaf behind it
+      return true;
+    }
     Point3 lo = ray.at(a), hi = ray.at(b);
     for (int k = 0; k < 3; ++k)
     {
@@ -473,7 +509,7 @@ private:
     const double fa = f(ws, stage, ray, a);
     if (fa >= 0)
     {
-      hit(ws, stage, ray, a, a, false);
+      found(ws, stage, ray, a, a);
       return true;
     }
     const double fb = f(ws, stage, ray, b);
@@ -496,16 +532,36 @@ private:
       refine.timeTolerance = tolerance_ / ray.length;
       refine.maxIterations = 100;
       const double root = frep::refineRoot(g, a, std::isnan(fa) ? -1.0 : fa, b, fb, refine);
-      hit(ws, stage, ray, root, inside, false);
+      found(ws, stage, ray, root, inside);
       return true;
     }
     const double m = 0.5 * (a + b);
     if ((b - a) * ray.length <= tolerance_ || !(m > a && m < b))
     {
-      hit(ws, stage, ray, m, m, true);
-      return true;
+      // A feature thinner than the tolerance may hide here. The search goes on behind it: a
+      // surface found within a leaf is taken instead (this piece was then the overestimate of
+      // intervals right in front of it); otherwise the pixel is covered here, unresolved.
+      double& u = unresolvedAt(ws, ray.i, ray.j);
+      if (std::isnan(u))
+      {
+        u = m;
+      }
+      return false;
     }
     return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
+  }
+
+  /// A crossing found at depth s (f >= 0 at depth `inside`): the pixel's surface, unless a piece
+  /// in front of it was left unresolved more than a leaf before.
+  void found(Workspace& ws, Stage& stage, const Ray& ray, double s, double inside)
+  {
+    const double u = unresolvedAt(ws, ray.i, ray.j);
+    if (!std::isnan(u) && (s - u) * ray.length > footprint(u))
+    {
+      hit(ws, *ws.root, ray, u, u, true);
+      return;
+    }
+    hit(ws, stage, ray, s, inside, false);
   }
 
   /// Records the pixel's surface at depth s; `inside` is a depth at which f >= 0 (where the

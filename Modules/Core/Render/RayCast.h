@@ -36,10 +36,13 @@
 //     uniform marching step, a tangency), the pixel is covered: finer uniform sampling of the
 //     ray cannot find anything this render misses.
 //   * The price of no miss: a piece no longer than the depth tolerance that intervals cannot
-//     exclude and whose sample ends are both outside counts as a hit ("unresolved", drawn in
-//     neutral grey). Such pixels are rays that pass within about the interval arithmetic's
-//     overestimate over a tolerance-long piece of the surface (for r^2 - |p|^2, within about
-//     twice the tolerance of the silhouette); RayCastResult counts them.
+//     exclude and whose sample ends are both outside may hold a feature thinner than the
+//     tolerance. The search goes on behind it; a crossing found within one leaf behind it is
+//     taken (the piece was the intervals' overestimate just in front of that surface), else the
+//     pixel is covered at that piece, "unresolved" (drawn in neutral grey, counted in
+//     RayCastResult). Such pixels are rays that pass within about the interval arithmetic's
+//     overestimate over a tolerance-long piece of the surface without meeting it (for
+//     r^2 - |p|^2, within about twice the tolerance of the silhouette).
 //   * Depth. The reported depth is never behind the first point of the ray with f >= 0 by more
 //     than one leaf (the pixel's footprint at that depth), and it is that point to the depth
 //     tolerance whenever the leaf that holds it holds only that crossing (every leaf in front
