@@ -64,18 +64,28 @@ struct Comparison
   double worst = 0; // the largest depth error among them
 };
 
-/// Compares a render with the union of `balls` pixel by pixel.
-Comparison compare(const RayCastResult& image, const Camera& camera, const std::vector<Ball>& balls)
+/// Calls visit(i, j, origin, unit direction) for the ray of every pixel centre.
+template <typename Visit>
+void forEachRay(const Camera& camera, Visit&& visit)
 {
-  Comparison c;
   for (int j = 0; j < camera.height(); ++j)
   {
     for (int i = 0; i < camera.width(); ++i)
     {
       const double u = camera.u(i), v = camera.v(j);
-      const Point3 o = camera.origin(u, v);
-      Point3 d = camera.direction(u, v);
-      d = scale(d, 1 / norm(d));
+      const Point3 d = camera.direction(u, v);
+      visit(i, j, camera.origin(u, v), scale(d, 1 / norm(d)));
+    }
+  }
+}
+
+/// Compares a render with the union of `balls` pixel by pixel.
+Comparison compare(const RayCastResult& image, const Camera& camera, const std::vector<Ball>& balls)
+{
+  Comparison c;
+  forEachRay(camera,
+    [&](int i, int j, const Point3& o, const Point3& d)
+    {
       double expected = std::numeric_limits<double>::infinity();
       bool nearEdge = false;
       for (const Ball& b : balls)
@@ -87,7 +97,7 @@ Comparison compare(const RayCastResult& image, const Camera& camera, const std::
       c.covered += std::isfinite(got) ? 1 : 0;
       if (nearEdge)
       {
-        continue;
+        return;
       }
       ++c.compared;
       if (std::isfinite(got) != std::isfinite(expected))
@@ -100,8 +110,7 @@ Comparison compare(const RayCastResult& image, const Camera& camera, const std::
         c.worst = std::max(c.worst, error);
         c.depth += error > Tolerance ? 1 : 0;
       }
-    }
-  }
+    });
   return c;
 }
 
@@ -213,14 +222,9 @@ TEST(RenderRayCast, ThinSlabIsFound)
     const RayCastResult image = rayCast(tape, Cube, camera, precise());
     PointEvaluator point(tape);
     int covered = 0, marchMisses = 0;
-    for (int j = 0; j < camera.height(); ++j)
-    {
-      for (int i = 0; i < camera.width(); ++i)
+    forEachRay(camera,
+      [&](int i, int j, const Point3& o, const Point3& d)
       {
-        const double u = camera.u(i), v = camera.v(j);
-        const Point3 o = camera.origin(u, v);
-        Point3 d = camera.direction(u, v);
-        d = scale(d, 1 / norm(d));
         // The face towards the camera, where the ray crosses it.
         const double front = dot(n, d) < 0 ? offset + half : offset - half;
         const double t = (front - dot(n, o)) / dot(n, d);
@@ -228,12 +232,12 @@ TEST(RenderRayCast, ThinSlabIsFound)
         const double got = image.depth[static_cast<std::size_t>(j) * camera.width() + i];
         if (std::abs(norm(q) - 0.8) < 1e-4)
         {
-          continue; // the rim, where the slab meets the ball's surface
+          return; // the rim, where the slab meets the ball's surface
         }
         if (norm(q) > 0.8)
         {
           EXPECT_FALSE(std::isfinite(got)) << i << "," << j;
-          continue;
+          return;
         }
         ++covered;
         EXPECT_NEAR(got, t, Tolerance) << i << "," << j;
@@ -244,8 +248,7 @@ TEST(RenderRayCast, ThinSlabIsFound)
           seen = point.eval(p[0], p[1], p[2]) >= 0;
         }
         marchMisses += seen ? 0 : 1;
-      }
-    }
+      });
     EXPECT_GT(covered, 80);
     EXPECT_GT(marchMisses, covered / 2);
   }

@@ -441,6 +441,13 @@ def check_bench(ictk, work):
         sys.exit(f"FAIL: andyhausen frames/points: {coherent} vs {full}")
     if not (coherent["cells_reused"] > 0 and full["cells_reused"] == 0 and coherent["coherence_speedup"] > 0):
         sys.exit(f"FAIL: andyhausen coherence counters: {coherent} vs {full}")
+    # The ray-casting workload (issue 14): its counters, not its time.
+    g = json.loads(run(ictk, ["bench", "--json", "--quick", "--only", "render-sphere-gyroid"]).stdout)
+    if [r["workload"] for r in g] != ["render-sphere-gyroid-128"]:
+        sys.exit(f"FAIL: render workloads: {g}")
+    details = g[0]["details"]
+    if not (details["covered_pixels"] > 1000 and details["interval_evaluations_per_pixel"] > 0):
+        sys.exit(f"FAIL: render-sphere-gyroid details: {details}")
     p = run(ictk, ["bench", "--only", "nothing-like-this"], check=False)
     if p.returncode != 2 or "ictk: error: --only" not in p.stderr:
         sys.exit(f"FAIL: --only without a match: exit {p.returncode}\n{p.stderr}")
