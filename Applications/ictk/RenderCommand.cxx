@@ -226,6 +226,12 @@ public:
               << ", " << std::fixed << std::setprecision(1) << result.intervalEvaluations / pixels
               << " interval evaluations per pixel) in " << std::setprecision(3) << seconds
               << " s\n";
+    if (result.cutPixels > 0)
+    {
+      std::cerr << "ictk: warning: " << result.cutPixels << " pixel(s) see '" << model.Name
+                << "' cut open: their rays start inside the solid (the camera is inside it, or "
+                   "the model's box cuts it)\n";
+    }
     if (result.coveredPixels == 0)
     {
       std::cerr << "ictk: warning: no surface of '" << model.Name

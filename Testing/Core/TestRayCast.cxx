@@ -315,6 +315,24 @@ TEST(RenderRayCast, NothingInView)
   }
 }
 
+TEST(RenderRayCast, CameraInsideTheSolid)
+{
+  // The eye at distance 0.3 from the centre of a ball of radius 0.9: every ray starts inside.
+  const Camera camera = Camera::orbit(Cube, { 0, 0, 0.3 }, Projection::Perspective, 16, 12);
+  const RayCastResult inside = rayCast(Tape::compile(ballField({ 0, 0, 0 }, 0.9)), Cube, camera);
+  EXPECT_EQ(inside.coveredPixels, 16 * 12);
+  EXPECT_EQ(inside.cutPixels, 16 * 12);
+  // A ball larger than the box is cut by its faces: the pixels that see a face are cut, at the
+  // depth where the ray enters the box.
+  const Camera front = Camera::orbit(Cube, { 0, 0, 3 }, Projection::Orthographic, 16, 16);
+  const RayCastResult cut = rayCast(Tape::compile(ballField({ 0, 0, 0 }, 1.2)), Cube, front);
+  EXPECT_GT(cut.cutPixels, 0);
+  EXPECT_LT(cut.cutPixels, cut.coveredPixels);
+  EXPECT_DOUBLE_EQ(cut.depth[8 * 16 + 8], 2.0); // the face x = 1, seen from x = 3
+  // Outside a ball nothing is cut.
+  EXPECT_EQ(rayCast(Tape::compile(ballField({ 0, 0, 0 }, 0.5)), Cube, front).cutPixels, 0);
+}
+
 TEST(RenderRayCast, SameResultOnAnyThreadCount)
 {
   const ModelInfo& info = findModel("walnut");

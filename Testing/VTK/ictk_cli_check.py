@@ -219,6 +219,10 @@ def check_render(ictk, work):
     finite.sort()
     if not (1.5 * h < finite[0] and finite[-1] < 3.5 * h and finite[len(finite) * 9 // 10] < 2.5 * h):
         sys.exit(f"FAIL: depths {min(finite)}..{max(finite)}")
+    # A camera inside the solid: a picture of the cut, with a warning.
+    p = run(ictk, ["render", "sphere", "-o", os.path.join(work, "inside.png"), "--size", "8,8", "--view", "0,0,0.1"])
+    if "ictk: warning: 64 pixel(s) see 'sphere' cut open" not in p.stderr:
+        sys.exit(f"FAIL: no warning for a camera inside the solid:\n{p.stderr}")
     # Nothing in view: an empty model's picture is all background, with a warning.
     empty = os.path.join(work, "empty.hf")
     with open(empty, "w") as f:

@@ -112,6 +112,7 @@ struct Ray
   Point3 origin{};
   Point3 direction{};
   double length = 1; // |direction|: the distance along the ray per unit of depth s
+  double start = 0;  // the depth where the ray enters the box (or the near end)
   double lastS = std::numeric_limits<double>::quiet_NaN();
   double lastF = 0;
   Point3 at(double s) const
@@ -142,7 +143,7 @@ struct Workspace
   std::vector<double> unresolvedAt;
   Stage* root = nullptr; // the full tape's stage of the current tile
   Rect tile{ 0, 0, 0, 0 };
-  std::int64_t intervals = 0, points = 0, covered = 0, unresolved = 0;
+  std::int64_t intervals = 0, points = 0, covered = 0, unresolved = 0, cut = 0;
 };
 
 class RayCaster
@@ -253,6 +254,7 @@ public:
         out_.pointEvaluations += slot->points;
         out_.coveredPixels += slot->covered;
         out_.unresolvedPixels += slot->unresolved;
+        out_.cutPixels += slot->cut;
       }
     }
   }
@@ -428,6 +430,8 @@ private:
   void pixel(Workspace& ws, Stage& stage, int i, int j, double s0, double s1)
   {
     Ray ray = rayOf(i, j);
+    // The ray's part inside the box: [entry, exit] of the depths near_..far_.
+    double entry = near_, exit = far_;
     for (int a = 0; a < 3; ++a)
     {
       const double o = ray.origin[a], d = ray.direction[a];
@@ -444,9 +448,12 @@ private:
       {
         std::swap(e0, e1);
       }
-      s0 = std::max(s0, e0);
-      s1 = std::min(s1, e1);
+      entry = std::max(entry, e0);
+      exit = std::min(exit, e1);
     }
+    ray.start = entry;
+    s0 = std::max(s0, entry);
+    s1 = std::min(s1, exit);
     if (!(s0 <= s1))
     {
       return;
@@ -562,6 +569,7 @@ private:
       return;
     }
     hit(ws, stage, ray, s, inside, false);
+    ws.cut += s == ray.start ? 1 : 0;
   }
 
   /// Records the pixel's surface at depth s; `inside` is a depth at which f >= 0 (where the

@@ -99,6 +99,10 @@ struct RayCastResult
   /// Covered because a piece no longer than the depth tolerance could not be excluded (see the
   /// file comment); a subset of coveredPixels.
   std::int64_t unresolvedPixels = 0;
+  /// Covered where the ray enters the solid's box or starts (the near end) already inside the
+  /// solid: the picture shows the solid cut there (a camera inside the solid, a box that cuts
+  /// it). A subset of coveredPixels.
+  std::int64_t cutPixels = 0;
   /// Interval evaluations of the tape (any length), and point evaluations of f.
   std::int64_t intervalEvaluations = 0;
   std::int64_t pointEvaluations = 0;
