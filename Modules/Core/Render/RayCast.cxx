@@ -481,19 +481,15 @@ private:
     {
       return false;
     }
-    std::optional<Stage> narrow;
-    if (TapePtr pruned = stage.narrowed())
-    {
-      narrow.emplace(std::move(pruned), options_.parameters, nullptr);
-    }
-    Stage& next = narrow ? *narrow : stage;
+    // The tape is not simplified again along one pixel's ray: building a tape there costs more
+    // than the instructions it removes (9% of the time of render-sphere-gyroid-1024).
     const double m = 0.5 * (a + b);
     const bool divisible = m > a && m < b;
     if (divisible && (b - a) * ray.length > std::max(footprint(b), tolerance_))
     {
-      return segment(ws, next, ray, a, m) || segment(ws, next, ray, m, b);
+      return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
     }
-    return leaf(ws, next, ray, a, b);
+    return leaf(ws, stage, ray, a, b);
   }
 
   double f(Workspace& ws, Stage& stage, Ray& ray, double s)

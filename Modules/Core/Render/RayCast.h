@@ -20,7 +20,8 @@
 //      (front half first) while the piece is deeper than it is wide, else as a quadtree over
 //      the rectangle. Pixels that found their surface are skipped by the nodes behind them.
 //   3. At one pixel the ray, clipped to the model's box, is cut in halves in depth, each checked
-//      by intervals, front first, down to a leaf no longer than the pixel's footprint at that
+//      by intervals (with the tape of the last node: simplifying per piece of one ray costs more
+//      than it saves), front first, down to a leaf no longer than the pixel's footprint at that
 //      depth. In a leaf f is evaluated at both ends: a sign change is refined by Illinois
 //      (FRep/RootFinding.h refineRoot) to the depth tolerance; two negative ends under an
 //      interval that does not exclude 0 mean a feature may hide inside, so the leaf is halved
