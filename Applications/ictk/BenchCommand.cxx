@@ -11,6 +11,9 @@
 //                         vtkSampleFunction on the equivalent vtkImplicitBoolean
 //   sphere-gyroid-0.025   dual contouring of libfive's sphereGyroid over [-5,5]^3 at feature
 //                         size 0.025, 2 threads (libfive: 4.74 s)
+//   render-sphere-gyroid-1024  ray casting (Render/RayCast.h) of the same sphereGyroid, 1024^2
+//                         pixels from the default view, 2 threads; pixels/s and interval
+//                         evaluations per pixel
 //   flower-256            the discretisation of every cell of Data/Models/flower/flower.json at
 //                         1/256 of its size (surfaces, patches, traced curves, points)
 //   andyhausen-100        a 10-second, 100-step run of Data/Models/icm/andyhausen.icm with the
@@ -33,6 +36,7 @@
 #endif
 #include "Lang/ComplexFile.h"
 #include "Lang/VmReader.h"
+#include "Render/RayCast.h"
 
 #include "ictkCsgRecipeToVtk.h"
 
@@ -335,6 +339,32 @@ Result SphereGyroid(double featureSize)
   return r;
 }
 
+Result RenderSphereGyroid(int size)
+{
+  Result r;
+  r.workload = "render-sphere-gyroid-" + std::to_string(size);
+  r.what = "ray casting of libfive's sphereGyroid over [-5,5]^3, " + std::to_string(size) + "^2 " +
+    "pixels, perspective from the default view";
+  r.threads = ThreadsOr(2);
+  r.unit = "Mpixels/s";
+  const frep::TapePtr tape = frep::Tape::compile(bundled::sphereGyroidField());
+  const frep::Box3 box{ { -5, -5, -5 }, { 5, 5, 5 } };
+  const render::Camera camera =
+    render::Camera::orbit(box, {}, render::Projection::Perspective, size, size);
+  render::RayCastOptions options;
+  options.threads = r.threads;
+  render::RayCastResult image;
+  r.allSeconds = Time(
+    Options.Runs, [&] { image = render::rayCast(tape, box, camera, options); }, &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  r.work = static_cast<double>(size) * size;
+  r.details["covered_pixels"] = image.coveredPixels;
+  r.details["unresolved_pixels"] = image.unresolvedPixels;
+  r.details["interval_evaluations_per_pixel"] = image.intervalEvaluations / r.work;
+  r.details["point_evaluations_per_pixel"] = image.pointEvaluations / r.work;
+  return r;
+}
+
 Result Flower(int divisions)
 {
   Result r;
@@ -599,6 +629,11 @@ int BenchCommand::run()
   if (Selected(gyroidName.str()))
   {
     report(SphereGyroid(gyroidSize));
+  }
+  const std::string renderGyroid = "render-sphere-gyroid-" + std::to_string(renderSize);
+  if (Selected(renderGyroid))
+  {
+    report(RenderSphereGyroid(renderSize));
   }
   const int flowerDivisions = Options.Quick ? 64 : 256;
   if (Selected("flower-" + std::to_string(flowerDivisions)))

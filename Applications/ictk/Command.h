@@ -52,6 +52,7 @@ std::unique_ptr<Command> sampleCommand();   // SampleCommand.cxx
 std::unique_ptr<Command> convertCommand();  // ConvertCommand.cxx
 std::unique_ptr<Command> benchCommand();    // BenchCommand.cxx
 std::unique_ptr<Command> meshCommand();     // MeshCommand.cxx
+std::unique_ptr<Command> renderCommand();   // RenderCommand.cxx
 std::unique_ptr<Command> tetraCommand();    // TetraCommand.cxx
 std::unique_ptr<Command> runCommand();      // RunCommand.cxx
 std::unique_ptr<Command> infoCommand();     // InfoCommand.cxx

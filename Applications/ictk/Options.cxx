@@ -157,28 +157,35 @@ std::vector<double> ParseParameters(const std::string& text)
   return ParseNumbers(text, "--params", {}, 1, 1024, "p1,p2,...");
 }
 
-std::array<std::int64_t, 3> ParseDims(const std::string& text)
+std::vector<std::int64_t> ParseIntegers(const std::string& text, const std::string& option,
+  const std::vector<std::string>& names, const std::string& expected)
 {
-  static const std::vector<std::string> names{ "NX", "NY", "NZ" };
   const std::vector<std::string> fields = Split(text, ',');
-  if (fields.size() != 3)
+  if (fields.size() != names.size())
   {
-    throw UserError("--dims: expected NX,NY,NZ, got " + std::to_string(fields.size()) +
+    throw UserError(option + ": expected " + expected + ", got " + std::to_string(fields.size()) +
       " value(s) in '" + text + "'");
   }
-  std::array<std::int64_t, 3> dims{};
-  for (int a = 0; a < 3; ++a)
+  std::vector<std::int64_t> values;
+  for (std::size_t a = 0; a < fields.size(); ++a)
   {
     errno = 0;
     char* end = nullptr;
     const long long v = std::strtoll(fields[a].c_str(), &end, 10);
     if (fields[a].empty() || end == fields[a].c_str() || *end != '\0' || errno == ERANGE)
     {
-      throw UserError("--dims: field '" + names[a] + "' is not an integer: '" + fields[a] + "'");
+      throw UserError(option + ": field '" + names[a] + "' is not an integer: '" + fields[a] + "'");
     }
-    dims[a] = v;
+    values.push_back(v);
   }
-  return dims;
+  return values;
+}
+
+std::array<std::int64_t, 3> ParseDims(const std::string& text)
+{
+  const std::vector<std::int64_t> v =
+    ParseIntegers(text, "--dims", { "NX", "NY", "NZ" }, "NX,NY,NZ");
+  return { v[0], v[1], v[2] };
 }
 
 std::vector<double> ParseFrames(const std::string& spec, const std::string& option)

@@ -2,8 +2,9 @@
 #pragma once
 // The options that several `ictk` commands share, added by one function each so that the same
 // thing has the same name (and help) in every command, and the parsing of their values: number
-// lists (--at, --bounds, --params), grid sizes (--dims), frame ranges (--frames T0:T1:DT) and file
-// extensions. Every parse error is a UserError whose message starts with the option's name.
+// lists (--at, --bounds, --params), integer lists (--dims, render's --size), frame ranges (--frames
+// T0:T1:DT) and file extensions. Every parse error is a UserError whose message starts with the
+// option's name.
 
 #include <array>
 #include <cstdint>
@@ -58,6 +59,10 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& opt
   const std::string& expected);
 /// --params: p1,p2,... (empty: none).
 std::vector<double> ParseParameters(const std::string& text);
+/// A comma-separated list of exactly names.size() integers (their range is checked by the
+/// caller); `expected` spells the form for the count's message (e.g. "NX,NY,NZ").
+std::vector<std::int64_t> ParseIntegers(const std::string& text, const std::string& option,
+  const std::vector<std::string>& names, const std::string& expected);
 /// --dims: NX,NY,NZ, integers (their range is checked by the caller).
 std::array<std::int64_t, 3> ParseDims(const std::string& text);
 

@@ -6,6 +6,7 @@
 //
 //   ictk models | eval | sample | mesh | convert      models and model files
 //   ictk info | validate | mesh | tetra                complexes
+//   ictk render MODEL -o picture.png                   a picture, ray-cast
 //   ictk run MODEL.icm --frames T0:T1:DT -o out.pvd    a dynamic complex, one .vtpc per frame
 //   ictk bench                                         the performance workloads
 //
@@ -46,6 +47,7 @@ int Run(int argc, char** argv)
   commands.push_back(convertCommand());
   commands.push_back(benchCommand());
   commands.push_back(meshCommand());
+  commands.push_back(renderCommand());
   commands.push_back(tetraCommand());
   commands.push_back(runCommand());
   commands.push_back(infoCommand());

@@ -4,7 +4,7 @@
 
 Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d | bench
-  | bench-scaling
+  | bench-scaling | render
   run-disk DATA | run-errors DATA   (ictk run on the .icm models in DATA/Models/icm)
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
 "@WORK@" in ICTK-ARGS is replaced by the work folder.
@@ -177,6 +177,66 @@ def check_sample_disk2d(ictk, work):
     image = read_image(vti)
     if image.GetDimensions() != (9, 9, 1):
         sys.exit(f"FAIL: a 2D model gives {image.GetDimensions()}, not (9, 9, 1)")
+
+
+def check_render(ictk, work):
+    """ictk render writes a PNG of the size asked, with the model in it; the depth buffer as
+    .vti; an empty view gives the background and a warning."""
+    import vtk
+    png, vti = os.path.join(work, "walnut.png"), os.path.join(work, "walnut.vti")
+    p = run(ictk, ["render", "walnut", "-o", png, "--size", "64,48", "--threads", "2", "--depth", vti])
+    if png not in p.stdout or vti not in p.stdout:
+        sys.exit(f"FAIL: the output paths are not printed:\n{p.stdout}")
+    r = vtk.vtkPNGReader()
+    r.SetFileName(png)
+    r.Update()
+    image = r.GetOutput()
+    if image.GetDimensions() != (64, 48, 1) or image.GetNumberOfScalarComponents() != 4:
+        sys.exit(f"FAIL: {image.GetDimensions()} with {image.GetNumberOfScalarComponents()} components")
+    scalars = image.GetPointData().GetScalars()
+    covered = [i for i in range(image.GetNumberOfPoints()) if scalars.GetComponent(i, 3) == 255]
+    if not 300 <= len(covered) < 64 * 48:
+        sys.exit(f"FAIL: {len(covered)} opaque pixels")
+    # The walnut's shell colour (0.55, 0.36, 0.2), shaded: red is the largest channel.
+    i = covered[len(covered) // 2]
+    rgb = [scalars.GetComponent(i, c) for c in range(3)]
+    if not rgb[0] > rgb[1] > rgb[2] > 0:
+        sys.exit(f"FAIL: pixel {i} is {rgb}, not the walnut's brown")
+    if scalars.GetComponent(0, 3) != 0:
+        sys.exit("FAIL: the corner is not background")
+    depth = read_image(vti)
+    d = depth.GetPointData().GetArray("depth")
+    if depth.GetDimensions() != (64, 48, 1) or d is None:
+        sys.exit("FAIL: the depth buffer")
+    for k in range(depth.GetNumberOfPoints()):
+        if (scalars.GetComponent(k, 3) == 255) != math.isfinite(d.GetValue(k)):
+            sys.exit(f"FAIL: pixel {k}: colour and depth disagree on coverage")
+    # The eye is 2.5 half-diagonals of the walnut's box from its centre: its surface lies
+    # between 1.5 and 3.5 half-diagonals away, and what is seen mostly on the near side.
+    finite = [d.GetValue(k) for k in covered]
+    b = [m for m in json.loads(run(ictk, ["models", "--json"]).stdout) if m["name"] == "walnut"][0]["bounds"]
+    h = 0.5 * math.sqrt(sum((b[2 * a + 1] - b[2 * a]) ** 2 for a in range(3)))
+    finite.sort()
+    if not (1.5 * h < finite[0] and finite[-1] < 3.5 * h and finite[len(finite) * 9 // 10] < 2.5 * h):
+        sys.exit(f"FAIL: depths {min(finite)}..{max(finite)}")
+    # A camera inside the solid: a picture of the cut, with a warning.
+    p = run(ictk, ["render", "sphere", "-o", os.path.join(work, "inside.png"), "--size", "8,8", "--view", "0,0,0.1"])
+    if "ictk: warning: 64 pixel(s) see 'sphere' cut open" not in p.stderr:
+        sys.exit(f"FAIL: no warning for a camera inside the solid:\n{p.stderr}")
+    # Nothing in view: an empty model's picture is all background, with a warning.
+    empty = os.path.join(work, "empty.hf")
+    with open(empty, "w") as f:
+        f.write("empty(x[3], a[1])\n{\n  empty = -1 - x[1] * x[1];\n}\n")
+    out = os.path.join(work, "empty.png")
+    p = run(ictk, ["render", empty, "-o", out, "--size", "8,8", "--projection", "orthographic"])
+    if "ictk: warning: no surface" not in p.stderr or not os.path.exists(out):
+        sys.exit(f"FAIL: no warning or no picture for an empty view:\n{p.stderr}")
+    r.SetFileName(out)
+    r.Update()
+    alpha = r.GetOutput().GetPointData().GetScalars()
+    if any(alpha.GetComponent(k, 3) != 0 for k in range(64)):
+        sys.exit("FAIL: the empty picture is not background")
+    no_leftovers(work)
 
 
 def check_error(ictk, work, pattern, args):
@@ -385,6 +445,13 @@ def check_bench(ictk, work):
         sys.exit(f"FAIL: andyhausen frames/points: {coherent} vs {full}")
     if not (coherent["cells_reused"] > 0 and full["cells_reused"] == 0 and coherent["coherence_speedup"] > 0):
         sys.exit(f"FAIL: andyhausen coherence counters: {coherent} vs {full}")
+    # The ray-casting workload (issue 14): its counters, not its time.
+    g = json.loads(run(ictk, ["bench", "--json", "--quick", "--only", "render-sphere-gyroid"]).stdout)
+    if [r["workload"] for r in g] != ["render-sphere-gyroid-128"]:
+        sys.exit(f"FAIL: render workloads: {g}")
+    details = g[0]["details"]
+    if not (details["covered_pixels"] > 1000 and details["interval_evaluations_per_pixel"] > 0):
+        sys.exit(f"FAIL: render-sphere-gyroid details: {details}")
     p = run(ictk, ["bench", "--only", "nothing-like-this"], check=False)
     if p.returncode != 2 or "ictk: error: --only" not in p.stderr:
         sys.exit(f"FAIL: --only without a match: exit {p.returncode}\n{p.stderr}")
@@ -752,6 +819,7 @@ def main():
         "bench": check_bench,
         "bench-scaling": check_bench_scaling,
         "run-space-time": check_run_space_time,
+        "render": check_render,
     }
     if check == "tetra-bar":
         check_tetra_bar(ictk, work, rest[0])
