@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Discretize/CellDetail.h"
 
+#include "FRep/Threads.h"
+
 #include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -121,8 +122,8 @@ void forChunks(std::size_t n, std::size_t grain, int threads,
     body(tbb::blocked_range<std::size_t>(0, chunks));
     return;
   }
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-  arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), body); });
+  runOnThreads(
+    threads, [&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), body); });
 }
 
 void checkBox(const Box3& box, unsigned flatAxes, const char* what)

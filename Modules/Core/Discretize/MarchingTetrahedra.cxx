@@ -2,11 +2,11 @@
 #include "Discretize/MarchingTetrahedra.h"
 
 #include "FRep/Sampling.h"
+#include "FRep/Threads.h"
 #include "FRep/Vector.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -284,8 +284,7 @@ SurfaceMesh marchingTetrahedra(const frep::Field& field, const Box3& box, const 
     }
   };
 
-  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
-  arena.execute(
+  runOnThreads(o.threads,
     [&]
     {
       tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, blockCount, 1),
@@ -339,7 +338,7 @@ SurfaceMesh marchingTetrahedra(const frep::Field& field, const Box3& box, const 
     }
     return false;
   };
-  arena.execute(
+  runOnThreads(o.threads,
     [&]
     {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 256),

@@ -6,10 +6,10 @@
 #include "Discretize/MultiMaterial.h"
 
 #include "Discretize/MultiMaterialDetail.h"
+#include "FRep/Threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -149,11 +149,9 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
     }
   };
 
-  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
-
   // Phase 1: labels of the grid points, sampled only in blocks the intervals cannot decide.
   ProgressScope::Items labelled = progress.items(blockCount, 0, 0.4);
-  arena.execute(
+  runOnThreads(o.threads,
     [&]
     {
       tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, blockCount, 1),
@@ -312,7 +310,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
   progress.report(0.4);
 
   // Phase 2: triangles of the blocks with more than one label, as vertex keys.
-  arena.execute(
+  runOnThreads(o.threads,
     [&]
     {
       tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, blockCount, 1),
@@ -346,7 +344,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   MaterialSurface surface;
   surface.spacing = g.h;
-  surface.points = placeVertices(keys, g, labels, rank, solids, arena);
+  surface.points = placeVertices(keys, g, labels, rank, solids, o.threads);
   progress.report(0.8);
 
   for (const auto& r : results)

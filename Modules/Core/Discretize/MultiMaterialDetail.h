@@ -14,8 +14,6 @@
 #include "FRep/Sampling.h"
 #include "FRep/Vector.h"
 
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -162,6 +160,6 @@ void triangulateBlock(const Grid& g, const std::vector<Label>& labels,
 /// vertices at the mean of their face vertices. Identical for any thread count.
 std::vector<Point3> placeVertices(const std::vector<VKey>& keys, const Grid& g,
   const std::vector<Label>& labels, const Ranking& rank, const std::vector<frep::FieldPtr>& solids,
-  tbb::task_arena& arena);
+  int threads);
 
 } // namespace ictk::discretize::detail::material

@@ -7,6 +7,8 @@
 // so the positions do not depend on the threads.
 #include "Discretize/MultiMaterialDetail.h"
 
+#include "FRep/Threads.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
@@ -31,7 +33,7 @@ constexpr double kFaceAside = 0.1;
 
 std::vector<Point3> placeVertices(const std::vector<VKey>& keys, const Grid& g,
   const std::vector<Label>& labels, const Ranking& rank, const std::vector<frep::FieldPtr>& solids,
-  tbb::task_arena& arena)
+  int threads)
 {
   std::vector<std::uint32_t> edges, faces, centres;
   std::vector<Point3> pos(keys.size());
@@ -47,7 +49,7 @@ std::vector<Point3> placeVertices(const std::vector<VKey>& keys, const Grid& g,
   }
 
   // Edges: bisection on the winning label's field (in batches).
-  arena.execute(
+  runOnThreads(threads,
     [&]
     {
       tbb::parallel_for(
@@ -119,7 +121,7 @@ std::vector<Point3> placeVertices(const std::vector<VKey>& keys, const Grid& g,
 
   // Faces with three labels: on the segment between the two edge vertices next to the lowest
   // ranked corner, on the triple line.
-  arena.execute(
+  runOnThreads(threads,
     [&]
     {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, faces.size(), 64),

@@ -10,11 +10,11 @@
 #include "Discretize/Surface.h"
 
 #include "Discretize/SurfaceDetail.h"
+#include "FRep/Threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -262,15 +262,7 @@ SurfaceMesh contourSurface(
         }
       });
   };
-  if (options.threads > 0)
-  {
-    tbb::task_arena arena(options.threads);
-    arena.execute(run);
-  }
-  else
-  {
-    run();
-  }
+  runOnThreads(options.threads, run);
   progress.report(1.0);
   return mesh;
 }

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "FRep/Render.h"
 
+#include "FRep/Threads.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -107,15 +108,7 @@ public:
       }
     };
     const tbb::blocked_range<std::int64_t> all(0, count, 1);
-    if (options_.threads > 0)
-    {
-      tbb::task_arena arena(options_.threads);
-      arena.execute([&] { tbb::parallel_for(all, body); });
-    }
-    else
-    {
-      tbb::parallel_for(all, body);
-    }
+    runOnThreads(options_.threads, [&] { tbb::parallel_for(all, body); });
     if (options_.stats)
     {
       Counts total;

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "FRep/Sampling.h"
 
+#include "FRep/Threads.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <unistd.h>
 
@@ -221,16 +222,8 @@ void sampleRows(const TapePtr& tape, const Grid& grid, std::size_t bytesPerPoint
   };
   // Row evaluation and brick pruning are independent of which thread runs a brick, so the output
   // does not depend on the thread count.
-  if (options.threads > 0)
-  {
-    tbb::task_arena arena(options.threads);
-    arena.execute(
-      [&] { tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body); });
-  }
-  else
-  {
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body);
-  }
+  runOnThreads(options.threads,
+    [&] { tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, brickCount, 1), body); });
   if (options.stats)
   {
     options.stats->bricks = brickCount;

@@ -3,11 +3,11 @@
 
 #include "FRep/Evaluators.h"
 #include "FRep/RootFinding.h"
+#include "FRep/Threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -236,15 +236,7 @@ public:
       }
     };
     const tbb::blocked_range<std::int64_t> all(0, tileCount, 1);
-    if (options_.threads > 0)
-    {
-      tbb::task_arena arena(options_.threads);
-      arena.execute([&] { tbb::parallel_for(all, body); });
-    }
-    else
-    {
-      tbb::parallel_for(all, body);
-    }
+    runOnThreads(options_.threads, [&] { tbb::parallel_for(all, body); });
     progress.report(1);
     for (const auto& slot : workspaces)
     {

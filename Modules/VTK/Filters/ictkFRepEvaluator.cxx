@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkFRepEvaluator.h"
+
 #include "ictkFRepModel.h"
 
 #include "FRep/Evaluators.h"
 #include "FRep/Hypervolume.h"
 #include "FRep/Tape.h"
+#include "FRep/Threads.h"
 
 #include "vtkDataArray.h"
 #include "vtkObjectFactory.h"
@@ -12,7 +14,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -51,15 +52,7 @@ void ForBlocks(vtkIdType n, int threads, const Body& body)
         }
       });
   };
-  if (threads > 0)
-  {
-    tbb::task_arena arena(threads);
-    arena.execute(run);
-  }
-  else
-  {
-    run();
-  }
+  ictk::runOnThreads(threads, run);
 }
 
 /// The coordinates of points [begin, end) as four rows (t = `time` for 3-component points).
