@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Lang/IcmBuiltins.h"
 
-#include <stdexcept>
-
 namespace ictk::lang::icm
 {
 
@@ -102,14 +100,6 @@ const std::vector<Builtin>& builtins()
     { Id::Ceil, math, { "ceil", 1, 1, "ceil(real x)", "int" }, "rounded up" },
   };
   return table;
-}
-
-const Builtin& builtin(BuiltinId id)
-{
-  const Builtin& b = builtins().at(static_cast<std::size_t>(id));
-  if (b.id != id)
-    throw std::logic_error(std::string("the table of built-ins is out of order at ") + b.call.name);
-  return b;
 }
 
 const Builtin* findBuiltin(const std::string& name)

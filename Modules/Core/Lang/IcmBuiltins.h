@@ -88,7 +88,6 @@ struct Builtin
 
 /// The reaction library, indexed by BuiltinId.
 const std::vector<Builtin>& builtins();
-const Builtin& builtin(BuiltinId id);
 /// nullptr when `name` is not one of the built-ins.
 const Builtin* findBuiltin(const std::string& name);
 /// The rows of docs/icm.md's table of built-ins ("| `signature` | result: doc |"), one per entry.
