@@ -353,6 +353,9 @@ CalculixRun runCalculix(const std::string& deck, const CalculixOptions& options)
   }
   if (pid == 0)
   {
+    // A process group of its own: a terminal's Ctrl-C reaches the caller, which cancels through
+    // its progress callback and stops ccx here, rather than ccx dying under it.
+    ::setpgid(0, 0);
     if (::chdir(dir.c_str()) != 0 || ::dup2(log, 1) < 0 || ::dup2(log, 2) < 0)
     {
       ::_exit(126);

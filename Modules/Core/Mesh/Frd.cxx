@@ -450,6 +450,8 @@ PointResults resultsOnMesh(const TetMesh& mesh, const FrdResults& results)
   out.displacement.resize(u ? mesh.points.size() : 0);
   out.stress.resize(s ? mesh.points.size() : 0);
   out.vonMises.resize(s ? mesh.points.size() : 0);
+  const bool f = !results.force.empty();
+  out.force.resize(f ? mesh.points.size() : 0);
   for (std::size_t i = 0; i < mesh.points.size(); ++i)
   {
     const std::size_t k = i + 1 < results.indexOfId.size() ? results.indexOfId[i + 1] : none;
@@ -475,6 +477,10 @@ PointResults resultsOnMesh(const TetMesh& mesh, const FrdResults& results)
     {
       out.stress[i] = results.stress[k];
       out.vonMises[i] = vonMises(results.stress[k]);
+    }
+    if (f)
+    {
+      out.force[i] = results.force[k];
     }
   }
   return out;

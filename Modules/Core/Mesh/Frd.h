@@ -77,6 +77,8 @@ struct PointResults
   std::vector<std::array<double, 3>> displacement;
   std::vector<std::array<double, 6>> stress;
   std::vector<double> vonMises;
+  /// The reaction forces (FORC), zero where nothing is held.
+  std::vector<std::array<double, 3>> force;
 };
 PointResults resultsOnMesh(const TetMesh& mesh, const FrdResults& results);
 
