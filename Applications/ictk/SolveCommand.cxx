@@ -19,10 +19,12 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 namespace ictk::cli
 {
@@ -67,7 +69,7 @@ CLI::App* SolveCommand::add(CLI::App& app)
   solve->add_option("--work", o.Work,
     "Folder for the deck and CalculiX's files (default: OUTPUT without .vtu, plus '-ccx')");
   solve->add_option("--ccx", o.Ccx, "The CalculiX executable (default: ccx on PATH)");
-  AddThreads(solve, o.Threads, "CalculiX's threads (default 1)");
+  AddThreads(solve, o.Threads, "CalculiX's threads (default 1; 0: all cores)");
   AddJson(solve, o.Json, "Print the figures as JSON");
   return solve;
 }
@@ -90,10 +92,7 @@ int SolveCommand::run()
   {
     throw UserError("--bin-width must be positive (inf: one material per cell)");
   }
-  if (o.Threads < 1)
-  {
-    throw UserError("--threads must be at least 1 for CalculiX");
-  }
+  CheckThreads(o.Threads);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(o.Mesh, ec))
   {
@@ -120,7 +119,8 @@ int SolveCommand::run()
     "ictk solve " + o.Mesh + ": compression by " + std::to_string(o.Compression);
   mesh::CalculixOptions calculix;
   calculix.executable = o.Ccx;
-  calculix.threads = o.Threads;
+  calculix.threads =
+    o.Threads > 0 ? o.Threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   InterruptScope interrupts;
   ProgressBar bar("ccx", false, !o.Json);
   calculix.progress = [&](double fraction)
