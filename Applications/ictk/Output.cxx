@@ -4,6 +4,9 @@
 #include "Command.h"
 
 #include <vtkDataObject.h>
+#include <vtkNew.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
 #include <vtkXMLWriterBase.h>
 
 #include <sys/stat.h>
@@ -115,6 +118,20 @@ void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::st
   }
   fs::rename(stagedFile, target);
   fs::remove_all(staging);
+}
+
+void WriteUnstructuredGrid(
+  vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination)
+{
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetInputData(grid);
+  writer->SetFileName(file.Path().c_str());
+  writer->SetDataModeToAppended();
+  if (writer->Write() != 1 || writer->GetErrorCode() != 0)
+  {
+    throw UserError("cannot write '" + destination + "'");
+  }
+  file.Commit();
 }
 
 } // namespace ictk::cli

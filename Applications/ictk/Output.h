@@ -7,6 +7,7 @@
 #include <string>
 
 class vtkDataObject;
+class vtkUnstructuredGrid;
 class vtkXMLWriterBase;
 
 namespace ictk::cli
@@ -36,5 +37,10 @@ private:
 /// temporary folder beside `output`, then moves both into place. An earlier pieces folder is
 /// replaced only when it holds nothing but pieces of this file.
 void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::string& output);
+
+/// Writes `grid` as a .vtu (appended data) into `file` and commits it; throws UserError naming
+/// `destination` when the writer fails.
+void WriteUnstructuredGrid(
+  vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination);
 
 } // namespace ictk::cli

@@ -18,7 +18,6 @@
 
 #include <vtkNew.h>
 #include <vtkUnstructuredGrid.h>
-#include <vtkXMLUnstructuredGridWriter.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -40,15 +39,7 @@ void WriteVtu(const mesh::TetMesh& m, const std::string& path)
   vtkNew<vtkUnstructuredGrid> grid;
   ictkTetrahedralize::Convert(m, grid);
   AtomicOutput file(path);
-  vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  writer->SetInputData(grid);
-  writer->SetFileName(file.Path().c_str());
-  writer->SetDataModeToAppended();
-  if (writer->Write() != 1 || writer->GetErrorCode() != 0)
-  {
-    throw UserError("cannot write '" + path + "'");
-  }
-  file.Commit();
+  WriteUnstructuredGrid(grid, file, path);
 }
 
 struct TetraOptions
