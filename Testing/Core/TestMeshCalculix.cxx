@@ -391,6 +391,31 @@ TEST(CalculixFrd, ReadsTheShortFormat)
   EXPECT_TRUE(std::isnan(r.displacement[0][0])); // node 1 left out of the block
 }
 
+TEST(CalculixFrd, ReadsContinuationRecords)
+{
+  // More than six components: a node's values go on over ' -2' records whose number columns
+  // are blank (5 in format 0).
+  std::string text = "    2C                             1                                     0\n"
+                     " -1    1 0.00000E+00 0.00000E+00 0.00000E+00\n"
+                     " -3\n"
+                     "  100CL  101 2.000000000           1                     0    1           0\n"
+                     " -4  MANY        8    1\n";
+  for (int c = 1; c <= 8; ++c)
+  {
+    text += " -5  C" + std::to_string(c) + "          1    1    0    0\n";
+  }
+  text += " -1    1 1.00000E+00 2.00000E+00 3.00000E+00 4.00000E+00 5.00000E+00 6.00000E+00\n"
+          " -2      7.00000E+00-8.00000E+00\n"
+          " -3\n"
+          " 9999\n";
+  Scratch s("frd8");
+  const auto r = mesh::readFrd(writeText(s, "many.frd", text));
+  const mesh::FrdBlock& b = r.blocks.at("MANY");
+  EXPECT_EQ(b.time, 2.0);
+  ASSERT_EQ(b.components.size(), 8u);
+  EXPECT_EQ(b.values, (std::vector<double>{ 1, 2, 3, 4, 5, 6, 7, -8 }));
+}
+
 TEST(CalculixFrd, ErrorsNameFileAndLine)
 {
   Scratch s("frdbad");
