@@ -648,4 +648,20 @@ TEST(CalculixCompression, RefusesWhatIsNoCompressionCase)
   const auto c = mesh::compressionCase(m, o, nullptr);
   EXPECT_EQ(c.bottomNodes.size(), 4u);
   EXPECT_NE(c.anchorNode, c.rollerNode);
+  // No modulus: the cell is named, and the folder solveCompression would have made is not left.
+  mesh::TetMesh bare = m;
+  bare.cellData.clear();
+  Scratch s("refused");
+  try
+  {
+    mesh::solveCompression(bare, s / "work", o, ccx());
+    FAIL() << "no error";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_THAT(e.what(),
+      HasSubstr("cell 'specimen') is a solver-unfriendly material: no "
+                "youngs_modulus attribute"));
+  }
+  EXPECT_FALSE(fs::exists(s / "work"));
 }
