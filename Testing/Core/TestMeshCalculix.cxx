@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <random>
 #include <set>
 #include <sstream>
@@ -507,6 +508,74 @@ TEST(CalculixRun, Cancels)
 
 namespace
 {
+/// An element's E as a written .inp gives it, read independently of the writer: *ELEMENT and
+/// *ELSET sets, *MATERIAL / *ELASTIC, *SOLID SECTION (element id -> E; an element given two
+/// sections is NaN).
+std::map<std::size_t, double> deckModuli(const std::string& path)
+{
+  std::map<std::string, std::vector<std::size_t>> sets;
+  std::map<std::string, double> modulus;
+  std::vector<std::pair<std::string, std::string>> sections; // (elset, material)
+  std::ifstream in(path);
+  std::string line, keyword, set, material;
+  auto parameter = [](const std::string& l, const std::string& name)
+  {
+    const auto at = l.find(name + "=");
+    return at == std::string::npos
+      ? std::string()
+      : l.substr(at + name.size() + 1, l.find(',', at) - at - name.size() - 1);
+  };
+  while (std::getline(in, line))
+  {
+    if (line.rfind("**", 0) == 0)
+    {
+      continue;
+    }
+    if (line[0] == '*')
+    {
+      keyword = line.substr(0, line.find(','));
+      set = parameter(line, "ELSET");
+      if (keyword == "*MATERIAL")
+      {
+        material = parameter(line, "NAME");
+      }
+      if (keyword == "*SOLID SECTION")
+      {
+        sections.emplace_back(set, parameter(line, "MATERIAL"));
+      }
+      continue;
+    }
+    std::istringstream fields(line);
+    std::string field;
+    if (keyword == "*ELASTIC")
+    {
+      std::getline(fields, field, ',');
+      modulus[material] = std::stod(field);
+    }
+    else if (keyword == "*ELEMENT")
+    {
+      std::getline(fields, field, ',');
+      sets[set].push_back(std::stoul(field));
+    }
+    else if (keyword == "*ELSET")
+    {
+      while (std::getline(fields, field, ','))
+      {
+        sets[set].push_back(std::stoul(field));
+      }
+    }
+  }
+  std::map<std::size_t, double> e;
+  for (const auto& [elset, name] : sections)
+  {
+    for (const std::size_t id : sets.at(elset))
+    {
+      e[id] = e.count(id) ? std::nan("") : modulus.at(name);
+    }
+  }
+  return e;
+}
+
 mesh::CompressionResult compress(const mesh::TetMesh& m, const Scratch& s, double d)
 {
   mesh::CompressionOptions o;
@@ -630,6 +699,24 @@ TEST(CalculixCompression, RandomModulusLiesBetweenTheBounds)
   EXPECT_GT(c.materials.size(), 300u);
   EXPECT_LE(c.reussModulus, r.apparentModulus);
   EXPECT_LE(r.apparentModulus, c.voigtModulus);
+  // The bounds are those of the deck as written: every element in one solid section, its E
+  // within one bin width of its own.
+  const auto written = deckModuli(s / "compression.inp");
+  ASSERT_EQ(written.size(), m.tetrahedra.size());
+  const auto& e = mesh::findArray(m, "youngs_modulus")->values;
+  double volume = 0, stiffness = 0, compliance = 0, worst = 0;
+  for (const auto& [id, modulus] : written)
+  {
+    ASSERT_FALSE(std::isnan(modulus)) << "element " << id << " has two sections";
+    const double v = volumeOf(m, id - 1);
+    volume += v;
+    stiffness += v * modulus;
+    compliance += v / modulus;
+    worst = std::max(worst, std::abs(std::log(modulus / e[id - 1])));
+  }
+  EXPECT_LT(worst, 0.01);
+  EXPECT_NEAR(c.voigtModulus / (stiffness / volume), 1, 1e-11);
+  EXPECT_NEAR(c.reussModulus / (volume / compliance), 1, 1e-11);
   std::printf("random box: %zu tetrahedra, %zu materials, Reuss %.2f <= E_app %.2f <= Voigt "
               "%.2f (E_app / Voigt %.4f, / Reuss %.4f), ccx %.3f s\n",
     m.tetrahedra.size(), c.materials.size(), c.reussModulus, r.apparentModulus, c.voigtModulus,
