@@ -611,6 +611,13 @@ TEST(CalculixCompression, HomogeneousBoxIsVoigt)
   const mesh::FrdResults frd = mesh::readFrd(r.run.frd);
   const mesh::PointResults p = mesh::resultsOnMesh(m, frd);
   ASSERT_EQ(p.displacement.size(), m.points.size());
+  ASSERT_EQ(frd.elements.size(), m.tetrahedra.size());
+  for (const mesh::FrdElement& element : frd.elements)
+  {
+    ASSERT_EQ(element.type, 3);
+    const auto& k = m.tetrahedra[element.id - 1];
+    EXPECT_EQ(element.nodes, (std::vector<std::size_t>{ k[0] + 1, k[1] + 1, k[2] + 1, k[3] + 1 }));
+  }
   const auto& anchor = m.points[c.anchorNode - 1];
   double worstU = 0, worstS = 0;
   for (std::size_t i = 0; i < m.points.size(); ++i)
