@@ -120,6 +120,9 @@ void GridCommandOptions::AddTo(CLI::App* command, std::int64_t defaultResolution
   AddTime(command, this->Time);
   AddThreads(command, this->Threads);
   AddParams(command, this->Params);
+  command->add_flag("--space-time", this->SpaceTime,
+    "An XYT model (2D over time) as the 3D solid of its space-time, z standing for t (the "
+    "thesis's figures of space-time blending); --bounds' z0,z1 are then the time range");
 }
 
 GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
@@ -131,6 +134,22 @@ GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
     throw UserError("--time must be a finite number");
   }
   CheckThreads(o.Threads);
+  if (o.SpaceTime)
+  {
+    try
+    {
+      plan.Model.Model = frep::spaceTimeSolid(plan.Model.Model);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      throw UserError("--space-time: '" + o.Model + "': " + e.what());
+    }
+    if (o.Bounds.empty())
+    {
+      throw UserError("--space-time needs --bounds x0,x1,y0,y1,t0,t1: z is the time axis, and a "
+                      "model's bounds have no time range");
+    }
+  }
   std::array<double, 3>& lo = plan.Model.Lo;
   std::array<double, 3>& hi = plan.Model.Hi;
   if (!o.Bounds.empty())

@@ -39,6 +39,9 @@ struct GridCommandOptions
   double Time = 0;
   int Threads = 0;
   std::string Params;
+  /// An XYT model (2D over time) sampled as the 3D solid of its space-time, z standing for t
+  /// (frep::spaceTimeSolid).
+  bool SpaceTime = false;
 
   /// Adds the model argument and the grid options (not -o, whose help differs per command).
   void AddTo(CLI::App* command, std::int64_t defaultResolution);

@@ -11,9 +11,11 @@
 #include "Engine/DynamicModel.h"
 #include "Engine/Interpreter.h"
 #include "FRep/Evaluators.h"
+#include "FRep/Hypervolume.h"
 #include "FRep/Operations.h"
 #include "FRep/Tape.h"
 #include "Geometry/Queries.h"
+#include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 #include "Lang/Icm.h"
 
@@ -335,4 +337,32 @@ TEST(SpaceTimeBlend, OperandsBlendAsTheyArePlaced)
         ++differ;
     }
   EXPECT_EQ(differ, 0);
+}
+
+TEST(SpaceTimeBlend, XYTModelIsASolidOfSpaceTime)
+{
+  // Data/Models/stb_cross_disks_xyt.xml: the same blend in XYT (t0 = 0, t1 = 1). As a solid of
+  // space-time (ictk sample/mesh --space-time) its value at (x, y, z) is the model's at t = z.
+  const ictk::frep::Hypervolume xyt =
+    ictk::lang::readFRepXmlFile(std::string(ICTK_DATA_DIR) + "/Models/stb_cross_disks_xyt.xml");
+  ASSERT_EQ(xyt.geometry().domain(), ictk::frep::Domain::XYT);
+  const ictk::frep::Hypervolume solid = ictk::frep::spaceTimeSolid(xyt);
+  EXPECT_EQ(solid.geometry().domain(), ictk::frep::Domain::XYZ);
+  ictk::frep::PointEvaluator model(ictk::frep::Tape::compile(xyt.geometry().function()));
+  ictk::frep::PointEvaluator space(ictk::frep::Tape::compile(solid.geometry().function()));
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  for (int k = 0; k < 500; ++k)
+  {
+    const double x = u(random), y = u(random), t = 0.5 + u(random) / 1.5;
+    EXPECT_EQ(space.eval(x, y, t, 123.0), model.eval(x, y, 0, t));
+    // Before t0 the cross, after t1 the disks.
+    if (std::abs(cross(x, y)) > 1e-9)
+      EXPECT_EQ(space.eval(x, y, -0.25, 0) >= 0, cross(x, y) > 0);
+    if (std::abs(disks(x, y)) > 1e-9)
+      EXPECT_EQ(space.eval(x, y, 1.25, 0) >= 0, disks(x, y) > 0);
+  }
+  EXPECT_THROW(ictk::frep::spaceTimeSolid(ictk::frep::Hypervolume(
+                 ictk::frep::Shape(ictk::frep::Expr::x(), ictk::frep::Domain::XYZ))),
+    ictk::frep::DomainError);
 }

@@ -136,4 +136,30 @@ int HypervolumeEvaluator::membership(const std::array<double, 4>& p)
   return f > T ? 2 : (f == T ? 1 : 0);
 }
 
+Hypervolume spaceTimeSolid(const Hypervolume& hv)
+{
+  if (hv.geometry().domain() != Domain::XYT)
+  {
+    throw DomainError(std::string("spaceTimeSolid: the model's domain is ") +
+      domainName(hv.geometry().domain()) +
+      "; only an XYT model (2D over time) is a 3D solid in space-time");
+  }
+  std::array<Expr, AxisCount> map;
+  for (int a = 0; a < AxisCount; ++a)
+    map[static_cast<std::size_t>(a)] = Expr::variable(static_cast<Axis>(a));
+  map[static_cast<std::size_t>(Axis::T)] = Expr::z();
+  const Shape& g = hv.geometry();
+  Hypervolume out(
+    Shape(g.function().substitute(map), Domain::XYZ, "spaceTimeSolid(" + g.label() + ")"),
+    hv.threshold());
+  for (Attribute a : hv.attributes())
+  {
+    a.partition = a.partition.substitute(map);
+    for (Expr& c : a.components)
+      c = c.substitute(map);
+    out.addAttribute(std::move(a));
+  }
+  return out;
+}
+
 } // namespace ictk::frep

@@ -53,6 +53,12 @@ private:
   std::vector<Attribute> attributes_;
 };
 
+/// The space-time of a 2D model (domain XYT: a shape in the plane changing over time) as the XYZ
+/// solid it is, z standing for t: geometry, partitions and attribute components with t replaced
+/// by z. This is how the thesis shows space-time objects (figs. 93-95): the solid's slices
+/// z = t are the model's cross-sections. Throws DomainError for another domain.
+Hypervolume spaceTimeSolid(const Hypervolume& hv);
+
 /// Evaluates a hypervolume at points: f and the attribute values with the default rule of thesis
 /// L715, read consistently (thesis_ch2_3.md section 0.5): S_i where g_i >= 0, theta1 where
 /// f >= T, theta0 elsewhere.
