@@ -3,7 +3,12 @@
 
 #include "Command.h"
 
+#include "ictkTetrahedralize.h"
+
 #include <vtkDataObject.h>
+#include <vtkNew.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
 #include <vtkXMLWriterBase.h>
 
 #include <sys/stat.h>
@@ -115,6 +120,22 @@ void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::st
   }
   fs::rename(stagedFile, target);
   fs::remove_all(staging);
+}
+
+void WriteTetMeshVtu(const mesh::TetMesh& m, const std::string& path)
+{
+  vtkNew<vtkUnstructuredGrid> grid;
+  ictkTetrahedralize::Convert(m, grid);
+  AtomicOutput file(path);
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetInputData(grid);
+  writer->SetFileName(file.Path().c_str());
+  writer->SetDataModeToAppended();
+  if (writer->Write() != 1 || writer->GetErrorCode() != 0)
+  {
+    throw UserError("cannot write '" + path + "'");
+  }
+  file.Commit();
 }
 
 } // namespace ictk::cli

@@ -9,6 +9,11 @@
 class vtkDataObject;
 class vtkXMLWriterBase;
 
+namespace ictk::mesh
+{
+struct TetMesh;
+}
+
 namespace ictk::cli
 {
 
@@ -36,5 +41,9 @@ private:
 /// temporary folder beside `output`, then moves both into place. An earlier pieces folder is
 /// replaced only when it holds nothing but pieces of this file.
 void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::string& output);
+
+/// A tetrahedral mesh as a .vtu (ictkTetrahedralize's form: MaterialId, CellId, the per-tetrahedron
+/// arrays), through a temporary file renamed on success.
+void WriteTetMeshVtu(const mesh::TetMesh& mesh, const std::string& path);
 
 } // namespace ictk::cli

@@ -90,8 +90,8 @@ double scanModulus(double hu, const ScanMaterialOptions& options)
   return binnedModulus(unbinned(hu, options), options);
 }
 
-ScanMaterialSummary assignScanMaterials(
-  TetMesh& mesh, const frep::Field& hu, const ScanMaterialOptions& options)
+void checkScanMaterials(
+  const ScanMaterialOptions& options, const std::vector<std::string>& materialNames)
 {
   if (!(options.binWidth >= 0) || !(options.minimumModulus > 0) ||
     !(options.poissonRatio > -1 && options.poissonRatio < 0.5))
@@ -101,16 +101,14 @@ ScanMaterialSummary assignScanMaterials(
   }
   for (const auto& name : options.scanCells)
   {
-    if (std::find(mesh.materialNames.begin(), mesh.materialNames.end(), name) ==
-      mesh.materialNames.end())
+    if (std::find(materialNames.begin(), materialNames.end(), name) == materialNames.end())
     {
       throw std::invalid_argument("scan materials: '" + name + "' is no cell of the mesh");
     }
   }
   for (const auto& [name, m] : options.fixed)
   {
-    if (std::find(mesh.materialNames.begin(), mesh.materialNames.end(), name) ==
-      mesh.materialNames.end())
+    if (std::find(materialNames.begin(), materialNames.end(), name) == materialNames.end())
     {
       throw std::invalid_argument("scan materials: '" + name + "' is no cell of the mesh");
     }
@@ -121,6 +119,20 @@ ScanMaterialSummary assignScanMaterials(
         "' needs a positive modulus and density and a Poisson ratio in (-1, 0.5)");
     }
   }
+  for (const auto& name : materialNames)
+  {
+    if (!options.scanCells.count(name) && !options.fixed.count(name))
+    {
+      throw std::invalid_argument(
+        "scan materials: cell '" + name + "' is neither a scan cell nor given a fixed material");
+    }
+  }
+}
+
+ScanMaterialSummary assignScanMaterials(
+  TetMesh& mesh, const frep::Field& hu, const ScanMaterialOptions& options)
+{
+  checkScanMaterials(options, mesh.materialNames);
   // Per material: from the scan (nullptr) or fixed.
   std::vector<const FixedMaterial*> fixed;
   for (const auto& name : mesh.materialNames)
@@ -130,14 +142,9 @@ ScanMaterialSummary assignScanMaterials(
     {
       fixed.push_back(nullptr);
     }
-    else if (it != options.fixed.end())
-    {
-      fixed.push_back(&it->second);
-    }
     else
     {
-      throw std::invalid_argument(
-        "scan materials: cell '" + name + "' is neither a scan cell nor given a fixed material");
+      fixed.push_back(&it->second); // checkScanMaterials made sure it is there
     }
   }
   const std::size_t n = mesh.tetrahedra.size();

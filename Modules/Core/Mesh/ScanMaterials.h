@@ -99,6 +99,11 @@ struct ScanMaterialSummary
 ScanMaterialSummary assignScanMaterials(
   TetMesh& mesh, const frep::Field& hu, const ScanMaterialOptions& options);
 
+/// The checks of assignScanMaterials that need no mesh (a study runs them before meshing):
+/// `materialNames` as TetMesh::materialNames.
+void checkScanMaterials(
+  const ScanMaterialOptions& options, const std::vector<std::string>& materialNames);
+
 /// The modulus of one HU value under the options' laws, floor and binning (what
 /// assignScanMaterials gives an element whose sampled HU is `hu`, in centroid mode).
 double scanModulus(double hu, const ScanMaterialOptions& options);

@@ -1,0 +1,333 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// `ictk study`: a medical study in one line (issue 15, docs/medical.md): a complex whose voxel
+// cell is a scan clipped to a specimen and whose other cells are implants placed in it, meshed
+// into labelled tetrahedra by the CGAL backend, every tetrahedron given a material (from the scan
+// under it, or fixed by its cell), written as a .vtu and a CalculiX/Abaqus .inp. The study's
+// settings are the complex file's "study" object; everything is checked before anything is
+// written, and the two files appear together or not at all.
+#include "Command.h"
+#include "Models.h"
+#include "Options.h"
+#include "Output.h"
+#include "ProgressDisplay.h"
+
+#include "Mesh/Backends/Backends.h"
+#include "Mesh/Quality.h"
+#include "Mesh/ScanMaterials.h"
+#include "Mesh/Writers.h"
+#include "Voxel/VolumeFile.h"
+#include "Voxel/VoxelField.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace ictk::cli
+{
+namespace
+{
+
+using Json = nlohmann::json;
+namespace fs = std::filesystem;
+
+/// The "study" object of a complex file, with the defaults of docs/medical.md.
+struct StudySettings
+{
+  double size = 1;
+  std::string scan;
+  std::string scanFile;
+  std::string scanArray;
+  std::vector<std::string> implants;
+  mesh::ScanMaterialOptions materials;
+};
+
+double numberAt(const Json& j, const char* key, double fallback, const std::string& where)
+{
+  if (!j.contains(key))
+  {
+    return fallback;
+  }
+  if (!j[key].is_number())
+  {
+    throw UserError(where + ": \"" + key + "\" must be a number");
+  }
+  return j[key].get<double>();
+}
+
+StudySettings readSettings(const std::string& path)
+{
+  std::ifstream in(path);
+  if (!in)
+  {
+    throw UserError("cannot read '" + path + "'");
+  }
+  Json doc;
+  try
+  {
+    doc = Json::parse(in);
+  }
+  catch (const std::exception& e)
+  {
+    throw UserError("'" + path + "': " + e.what());
+  }
+  const std::string where = "'" + path + "': study";
+  if (!doc.contains("study") || !doc["study"].is_object())
+  {
+    throw UserError("'" + path + "' has no \"study\" object (docs/medical.md)");
+  }
+  const Json& s = doc["study"];
+  StudySettings out;
+  out.size = numberAt(s, "size", 1, where);
+  out.scan = s.value("scan", std::string());
+  // The scan cell's file, resolved as the complex reader resolves it.
+  for (const auto& cell : doc.value("cells", Json::array()))
+  {
+    if (cell.value("name", std::string()) == out.scan && cell.value("kind", std::string()) == "V")
+    {
+      const fs::path file = cell.value("file", std::string());
+      out.scanFile =
+        file.is_absolute() ? file.string() : (fs::path(path).parent_path() / file).string();
+      out.scanArray = cell.value("array", std::string());
+    }
+  }
+  if (out.scanFile.empty())
+  {
+    throw UserError(where + ": \"scan\" must name a voxel (V) cell of the complex");
+  }
+  out.implants = s.value("implants", std::vector<std::string>());
+  auto& m = out.materials;
+  const std::vector<std::string> scanCells =
+    s.value("scan_cells", std::vector<std::string>{ out.scan });
+  m.scanCells.insert(scanCells.begin(), scanCells.end());
+  if (s.contains("density_law"))
+  {
+    m.density.a = numberAt(s["density_law"], "a", m.density.a, where + ".density_law");
+    m.density.b = numberAt(s["density_law"], "b", m.density.b, where + ".density_law");
+  }
+  if (s.contains("modulus_law"))
+  {
+    m.modulus.a = numberAt(s["modulus_law"], "a", m.modulus.a, where + ".modulus_law");
+    m.modulus.b = numberAt(s["modulus_law"], "b", m.modulus.b, where + ".modulus_law");
+    m.modulus.c = numberAt(s["modulus_law"], "c", m.modulus.c, where + ".modulus_law");
+  }
+  const std::string sampling = s.value("sampling", std::string("integrated"));
+  if (sampling != "integrated" && sampling != "centroid")
+  {
+    throw UserError(where + ": \"sampling\" must be \"integrated\" or \"centroid\"");
+  }
+  m.sampling =
+    sampling == "centroid" ? mesh::ScanSampling::Centroid : mesh::ScanSampling::Integrated;
+  m.binWidth = numberAt(s, "bin_width", m.binWidth, where);
+  m.poissonRatio = numberAt(s, "poisson_ratio", m.poissonRatio, where);
+  m.minimumModulus = numberAt(s, "minimum_modulus", m.minimumModulus, where);
+  const Json fixed = s.value("fixed", Json::object());
+  for (const auto& [name, f] : fixed.items())
+  {
+    mesh::FixedMaterial fm;
+    fm.youngsModulus = numberAt(f, "youngs_modulus", 0, where + ".fixed." + name);
+    fm.poissonRatio = numberAt(f, "poisson_ratio", 0.3, where + ".fixed." + name);
+    fm.density = numberAt(f, "density", 1, where + ".fixed." + name);
+    m.fixed[name] = fm;
+  }
+  return out;
+}
+
+/// An implant must lie in the specimen: its cell's box inside the scan cell's (the clip).
+void checkImplants(const complex::Complex& k, const StudySettings& s)
+{
+  auto boundsOf = [&](const std::string& name) -> frep::Box3
+  {
+    for (complex::CellId id : k.cellsOfDimension(3))
+    {
+      const complex::Cell& c = k.cell(id);
+      if (c.name == name)
+      {
+        if (const auto* g = std::get_if<complex::ImplicitGeometry>(&c.geometry))
+        {
+          return g->bounds;
+        }
+      }
+    }
+    throw UserError("study: no implicit solid cell named '" + name + "'");
+  };
+  const frep::Box3 specimen = boundsOf(s.scan);
+  for (const auto& name : s.implants)
+  {
+    const frep::Box3 b = boundsOf(name);
+    for (int a = 0; a < 3; ++a)
+    {
+      const double slack = 1e-9 * (specimen.hi[a] - specimen.lo[a]);
+      if (b.lo[a] < specimen.lo[a] - slack || b.hi[a] > specimen.hi[a] + slack)
+      {
+        std::ostringstream m;
+        m << "study: implant '" << name << "' reaches outside the specimen on axis "
+          << "xyz"[a] << ": [" << b.lo[a] << ", " << b.hi[a] << "] is not within ["
+          << specimen.lo[a] << ", " << specimen.hi[a] << "]";
+        throw UserError(m.str());
+      }
+    }
+  }
+}
+
+struct StudyOptions
+{
+  std::string Model;
+  std::string Output;
+  std::string Inp;
+  double Size = 0;
+  bool Deterministic = false;
+  bool Json = false;
+  int Threads = 0;
+};
+
+class StudyCommand final : public Command
+{
+public:
+  CLI::App* add(CLI::App& app) override;
+  int run() override;
+
+private:
+  StudyOptions o;
+};
+
+CLI::App* StudyCommand::add(CLI::App& app)
+{
+  CLI::App* study = app.add_subcommand("study",
+    "A scan-and-implant study (docs/medical.md): labelled tetrahedra with materials from the "
+    "scan, written as .vtu and .inp");
+  AddModel(study, o.Model, "A .json complex with a \"study\" object");
+  AddOutput(study, o.Output, "Output: the labelled mesh (.vtu)");
+  study->add_option("--inp", o.Inp, "The CalculiX/Abaqus deck (default: the output with .inp)");
+  AddSize(study, o.Size, "Target edge length (default: the study's \"size\")");
+  study->add_flag("--deterministic", o.Deterministic, "Identical output run to run");
+  AddThreads(study, o.Threads);
+  AddJson(study, o.Json, "Print the report as JSON");
+  return study;
+}
+
+int StudyCommand::run()
+{
+  if (!HasExtension(o.Output, ".vtu"))
+  {
+    throw UserError("-o: '" + o.Output + "' is not a .vtu file");
+  }
+  const std::string inp =
+    o.Inp.empty() ? fs::path(o.Output).replace_extension(".inp").string() : o.Inp;
+  if (!HasExtension(inp, ".inp"))
+  {
+    throw UserError("--inp: '" + inp + "' is not a .inp file");
+  }
+  CheckThreads(o.Threads);
+  if (!mesh::hasBackend(mesh::Backend::Cgal))
+  {
+    throw UserError(
+      "the study needs the CGAL backend (configure with ICTK_ENABLE_GPL_BACKENDS=ON)");
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const StudySettings settings = readSettings(o.Model);
+  const complex::Complex k = LoadComplex(o.Model);
+  checkImplants(k, settings);
+  std::vector<std::string> cells;
+  for (complex::CellId id : k.cellsOfDimension(3))
+  {
+    cells.push_back(k.cell(id).name);
+  }
+  try
+  {
+    mesh::checkScanMaterials(settings.materials, cells);
+  }
+  catch (const std::exception& e)
+  {
+    throw UserError("'" + o.Model + "': study: " + e.what());
+  }
+  std::shared_ptr<voxel::VoxelGrid> grid;
+  try
+  {
+    grid = voxel::readCoreVolume(settings.scanFile, settings.scanArray);
+  }
+  catch (const std::exception& e)
+  {
+    throw UserError(std::string("study: the scan's Hounsfield units: ") + e.what());
+  }
+  const double readSeconds = Seconds(t0);
+  mesh::TetraOptions options;
+  options.size = o.Size > 0 ? o.Size : settings.size;
+  CheckSize(options.size);
+  options.deterministic = o.Deterministic;
+  options.threads = o.Threads;
+  ProgressBar bar("study", false, !o.Json);
+  options.progress = [&](double fraction)
+  {
+    bar.Show(fraction);
+    return true;
+  };
+  mesh::ValidityReport validity;
+  const auto t1 = std::chrono::steady_clock::now();
+  mesh::TetMesh m = [&]
+  {
+    try
+    {
+      return mesh::tetrahedralize(k, mesh::Backend::Cgal, options, &validity);
+    }
+    catch (...)
+    {
+      bar.End();
+      throw;
+    }
+  }();
+  bar.End();
+  const double meshSeconds = Seconds(t1);
+  const mesh::ScanMaterialSummary bins =
+    mesh::assignScanMaterials(m, *voxel::voxelField(grid, 0), settings.materials);
+  // Both files or neither: the deck into its temporary file, the .vtu, then the deck's rename.
+  AtomicOutput deck(inp);
+  mesh::writeAbaqus(m, deck.Path());
+  WriteTetMeshVtu(m, o.Output);
+  deck.Commit();
+  const mesh::QualityReport q = mesh::measureQuality(m);
+  if (o.Json)
+  {
+    Json j;
+    j["output"] = o.Output;
+    j["inp"] = inp;
+    j["size"] = options.size;
+    j["read_seconds"] = readSeconds;
+    j["mesh_seconds"] = meshSeconds;
+    j["points"] = q.points;
+    j["tetrahedra"] = q.tetrahedra;
+    j["min_dihedral_degrees"] = q.minDihedralDegrees;
+    j["min_dihedral_percentile1_degrees"] = q.minDihedralPercentile1Degrees;
+    j["modulus_bins"] = bins.bins;
+    j["min_modulus"] = bins.minModulus;
+    j["max_modulus"] = bins.maxModulus;
+    j["materials"] = Json::array();
+    for (const auto& mq : q.materials)
+    {
+      j["materials"].push_back(
+        { { "name", mq.name }, { "tetrahedra", mq.tetrahedra }, { "volume", mq.volume } });
+    }
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "wrote " << o.Output << " and " << inp << " (" << q.tetrahedra
+            << " tetrahedra, size " << options.size << "; scan read in " << readSeconds
+            << " s, meshed in " << meshSeconds << " s)\n"
+            << "scan materials: " << bins.bins << " modulus bins, " << bins.minModulus << " to "
+            << bins.maxModulus << " MPa\n"
+            << mesh::formatQualityReport(q);
+  return 0;
+}
+
+} // namespace
+
+std::unique_ptr<Command> studyCommand()
+{
+  return std::make_unique<StudyCommand>();
+}
+
+} // namespace ictk::cli
