@@ -122,20 +122,26 @@ void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::st
   fs::remove_all(staging);
 }
 
-void WriteTetMeshVtu(const mesh::TetMesh& m, const std::string& path)
+void WriteUnstructuredGrid(
+  vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination)
 {
-  vtkNew<vtkUnstructuredGrid> grid;
-  ictkTetrahedralize::Convert(m, grid);
-  AtomicOutput file(path);
   vtkNew<vtkXMLUnstructuredGridWriter> writer;
   writer->SetInputData(grid);
   writer->SetFileName(file.Path().c_str());
   writer->SetDataModeToAppended();
   if (writer->Write() != 1 || writer->GetErrorCode() != 0)
   {
-    throw UserError("cannot write '" + path + "'");
+    throw UserError("cannot write '" + destination + "'");
   }
   file.Commit();
+}
+
+void WriteTetMeshVtu(const mesh::TetMesh& m, const std::string& path)
+{
+  vtkNew<vtkUnstructuredGrid> grid;
+  ictkTetrahedralize::Convert(m, grid);
+  AtomicOutput file(path);
+  WriteUnstructuredGrid(grid, file, path);
 }
 
 } // namespace ictk::cli

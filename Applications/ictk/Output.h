@@ -7,6 +7,7 @@
 #include <string>
 
 class vtkDataObject;
+class vtkUnstructuredGrid;
 class vtkXMLWriterBase;
 
 namespace ictk::mesh
@@ -42,8 +43,13 @@ private:
 /// replaced only when it holds nothing but pieces of this file.
 void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::string& output);
 
-/// A tetrahedral mesh as a .vtu (ictkTetrahedralize's form: MaterialId, CellId, the per-tetrahedron
-/// arrays), through a temporary file renamed on success.
+/// Writes `grid` as a .vtu (appended data) into `file` and commits it; throws UserError naming
+/// `destination` when the writer fails.
+void WriteUnstructuredGrid(
+  vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination);
+
+/// A tetrahedral mesh as a .vtu (ictkTetrahedralize's form: MaterialId, CellId and the
+/// per-tetrahedron arrays), through a temporary file renamed on success.
 void WriteTetMeshVtu(const mesh::TetMesh& mesh, const std::string& path);
 
 } // namespace ictk::cli

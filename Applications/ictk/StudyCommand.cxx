@@ -44,6 +44,8 @@ struct StudySettings
   std::string scanArray;
   std::vector<std::string> implants;
   mesh::ScanMaterialOptions materials;
+  /// The deck's modulus bins, in ln E (Writers.h deckMaterials).
+  double binWidth = 0.01;
 };
 
 double numberAt(const Json& j, const char* key, double fallback, const std::string& where)
@@ -122,7 +124,11 @@ StudySettings readSettings(const std::string& path)
   }
   m.sampling =
     sampling == "centroid" ? mesh::ScanSampling::Centroid : mesh::ScanSampling::Integrated;
-  m.binWidth = numberAt(s, "bin_width", m.binWidth, where);
+  out.binWidth = numberAt(s, "bin_width", out.binWidth, where);
+  if (!(out.binWidth > 0))
+  {
+    throw UserError(where + ": \"bin_width\" must be positive");
+  }
   m.poissonRatio = numberAt(s, "poisson_ratio", m.poissonRatio, where);
   m.minimumModulus = numberAt(s, "minimum_modulus", m.minimumModulus, where);
   const Json fixed = s.value("fixed", Json::object());
@@ -282,11 +288,14 @@ int StudyCommand::run()
   }();
   bar.End();
   const double meshSeconds = Seconds(t1);
-  const mesh::ScanMaterialSummary bins =
+  const mesh::ScanMaterialSummary moduli =
     mesh::assignScanMaterials(m, *voxel::voxelField(grid, 0), settings.materials);
+  mesh::AbaqusOptions abaqus;
+  abaqus.modulusBinWidth = settings.binWidth;
+  const std::size_t deckMaterials = mesh::deckMaterials(m, settings.binWidth).size();
   // Both files or neither: the deck into its temporary file, the .vtu, then the deck's rename.
   AtomicOutput deck(inp);
-  mesh::writeAbaqus(m, deck.Path());
+  mesh::writeAbaqus(m, deck.Path(), abaqus);
   WriteTetMeshVtu(m, o.Output);
   deck.Commit();
   const mesh::QualityReport q = mesh::measureQuality(m);
@@ -302,9 +311,9 @@ int StudyCommand::run()
     j["tetrahedra"] = q.tetrahedra;
     j["min_dihedral_degrees"] = q.minDihedralDegrees;
     j["min_dihedral_percentile1_degrees"] = q.minDihedralPercentile1Degrees;
-    j["modulus_bins"] = bins.bins;
-    j["min_modulus"] = bins.minModulus;
-    j["max_modulus"] = bins.maxModulus;
+    j["deck_materials"] = deckMaterials;
+    j["min_modulus"] = moduli.minModulus;
+    j["max_modulus"] = moduli.maxModulus;
     j["materials"] = Json::array();
     for (const auto& mq : q.materials)
     {
@@ -317,8 +326,9 @@ int StudyCommand::run()
   std::cout << "wrote " << o.Output << " and " << inp << " (" << q.tetrahedra
             << " tetrahedra, size " << options.size << "; scan read in " << readSeconds
             << " s, meshed in " << meshSeconds << " s)\n"
-            << "scan materials: " << bins.bins << " modulus bins, " << bins.minModulus << " to "
-            << bins.maxModulus << " MPa\n"
+            << "scan moduli " << moduli.minModulus << " to " << moduli.maxModulus << " MPa; "
+            << deckMaterials << " materials in the deck (" << 100 * settings.binWidth
+            << " % bins in ln E)\n"
             << mesh::formatQualityReport(q);
   return 0;
 }

@@ -50,6 +50,7 @@ int Run(int argc, char** argv)
   commands.push_back(renderCommand());
   commands.push_back(tetraCommand());
   commands.push_back(studyCommand());
+  commands.push_back(solveCommand());
   commands.push_back(runCommand());
   commands.push_back(infoCommand());
   commands.push_back(validateCommand());

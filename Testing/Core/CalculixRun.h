@@ -5,12 +5,12 @@
 // fail, not skip, when ccx is missing: Scripts/setup installs calculix-ccx, so a missing solver is
 // a broken install.
 
+#include "Mesh/Calculix.h"
 #include "Mesh/TetMesh.h"
 #include "Mesh/Writers.h"
 
 #include <array>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -32,7 +32,8 @@ struct CalculixRun
 };
 
 /// Writes `mesh` with `appendix` (the *BOUNDARY, *STEP... lines) to a fresh folder and runs
-/// `ccx` there (one thread). Throws std::runtime_error when ccx is not an existing file.
+/// `ccx` there (mesh::runCalculix, one thread; a failure is status 1 with its message after the
+/// log). Throws std::runtime_error when ccx is not an existing file.
 inline CalculixRun runCalculix(
   const mesh::TetMesh& mesh, const std::string& appendix, const std::string& ccx)
 {
@@ -50,10 +51,20 @@ inline CalculixRun runCalculix(
   options.heading = "ICTK mesh test";
   options.appendix = appendix;
   mesh::writeAbaqus(mesh, (dir / "job.inp").string(), options);
-  const std::string command =
-    "cd '" + dir.string() + "' && OMP_NUM_THREADS=1 '" + ccx + "' -i job > ccx.log 2>&1";
   CalculixRun run;
-  run.status = std::system(command.c_str());
+  mesh::CalculixOptions calculix;
+  calculix.executable = ccx;
+  std::string failure;
+  try
+  {
+    mesh::runCalculix((dir / "job.inp").string(), calculix);
+    run.status = 0;
+  }
+  catch (const std::runtime_error& e)
+  {
+    run.status = 1;
+    failure = std::string("\n") + e.what();
+  }
   auto slurp = [](const fs::path& p)
   {
     std::ifstream in(p);
@@ -61,7 +72,7 @@ inline CalculixRun runCalculix(
     s << in.rdbuf();
     return s.str();
   };
-  run.log = slurp(dir / "ccx.log");
+  run.log = slurp(dir / "job.log") + failure;
   run.dat = slurp(dir / "job.dat");
   // " displacements (vx,vy,vz) for set NALL and time  0.1000000E+01", a blank line, then rows
   // "node v1 v2 v3" up to the next blank line after some rows.

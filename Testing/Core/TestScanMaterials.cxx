@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Materials from a scan (issue 15, Mesh/ScanMaterials.h) on hand-made fields, against values
-// derived by hand: the default laws, binning, the integrated (Bonemat-style) mean of E over an
+// derived by hand: the default laws and floors, the integrated (Bonemat-style) mean of E over an
 // element (exact for a quadratic E), fixed materials by cell, and the refusals.
 
 #include "Mesh/ScanMaterials.h"
@@ -86,22 +86,16 @@ double value(const mesh::TetMesh& m, const char* name, std::size_t t)
   return mesh::findArray(m, name)->values.at(t);
 }
 
-TEST(ScanMaterials, DefaultLawsAndBinning)
+TEST(ScanMaterials, DefaultLaws)
 {
-  // HU 1000 -> rho = 1 + 0.001 * 1000 = 2 -> E = 6850 * 2^1.49.
+  // HU 1000 -> rho = 1 + 0.001 * 1000 = 2 -> E = 6850 * 2^1.49, in both samplings (constant).
   auto m = twoTets();
   const auto o = options();
   const FunctionField constant([](const frep::Point3&) { return 1000.0; });
   const auto summary = mesh::assignScanMaterials(m, constant, o);
   const double exact = 6850 * std::pow(2.0, 1.49);
-  const double e = value(m, "youngs_modulus", 0);
-  EXPECT_NEAR(e / exact, 1, 0.005);
-  // On the ladder (1.01)^k.
-  const double k = std::log(e) / std::log(1.01);
-  EXPECT_NEAR(k, std::round(k), 1e-9);
-  // The bin's density is the law's inverse at the binned modulus.
-  EXPECT_NEAR(value(m, "density", 0), std::pow(e / 6850, 1 / 1.49), 1e-12);
-  EXPECT_NEAR(value(m, "density", 0), 2, 2 * 0.005);
+  EXPECT_NEAR(value(m, "youngs_modulus", 0), exact, 1e-9 * exact);
+  EXPECT_NEAR(value(m, "density", 0), 2, 1e-12);
   EXPECT_EQ(value(m, "poisson_ratio", 0), 0.3);
   EXPECT_EQ(value(m, "label", 0), 1);
   // The pin's fixed material.
@@ -109,10 +103,15 @@ TEST(ScanMaterials, DefaultLawsAndBinning)
   EXPECT_EQ(value(m, "poisson_ratio", 1), 0.34);
   EXPECT_EQ(value(m, "density", 1), 4.43);
   EXPECT_EQ(value(m, "label", 1), 2);
-  EXPECT_EQ(summary.bins, 1u);
-  EXPECT_EQ(mesh::scanModulus(1000, o), e);
-  // Air: rho = 1 - 1.024 < 0 -> the floor, 1 MPa (on the ladder: k = 0).
+  EXPECT_NEAR(summary.minModulus, exact, 1e-9 * exact);
+  EXPECT_EQ(summary.maxModulus, summary.minModulus);
+  EXPECT_NEAR(mesh::scanModulus(1000, o), exact, 1e-9 * exact);
+  // Air: rho = 1 - 1.024 < 0 -> E at the 1 MPa floor, density at its 0.001 floor.
   EXPECT_EQ(mesh::scanModulus(-1024, o), 1);
+  const FunctionField air([](const frep::Point3&) { return -1024.0; });
+  mesh::assignScanMaterials(m, air, o);
+  EXPECT_EQ(value(m, "youngs_modulus", 0), 1);
+  EXPECT_EQ(value(m, "density", 0), 1e-3);
 }
 
 TEST(ScanMaterials, IntegratedIsTheMeanOfE)
@@ -123,7 +122,6 @@ TEST(ScanMaterials, IntegratedIsTheMeanOfE)
   auto m = twoTets();
   auto o = options();
   o.modulus = { 0, 100, 2 };
-  o.binWidth = 0;
   const FunctionField linear([](const frep::Point3& p) { return 1000 * p[0]; });
   mesh::assignScanMaterials(m, linear, o);
   const double squares = 1 + 4 + 1 + 1;
@@ -160,8 +158,8 @@ TEST(ScanMaterials, Refusals)
   o.scanCells.insert("marrow");
   EXPECT_THAT(error(o), HasSubstr("'marrow' is no cell of the mesh"));
   o = options();
-  o.binWidth = -0.1;
-  EXPECT_THAT(error(o), HasSubstr("bin width"));
+  o.minimumModulus = 0;
+  EXPECT_THAT(error(o), HasSubstr("minimum modulus"));
   o = options();
   o.fixed["pin"].youngsModulus = 0;
   EXPECT_THAT(error(o), HasSubstr("'pin' needs a positive modulus"));

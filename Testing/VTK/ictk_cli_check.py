@@ -6,6 +6,7 @@ Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d | bench
   | bench-scaling | render
   run-disk DATA | run-errors DATA   (ictk run on the .icm models in DATA/Models/icm)
+  tetra-bar DATA | solve-bar DATA   (ictk tetra and ictk solve on DATA/Models/bar)
   study DATA   (ictk study on DATA/Studies/ct-implant and its bad inputs; needs invesalius-examples)
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
 "@WORK@" in ICTK-ARGS is replaced by the work folder.
@@ -598,6 +599,65 @@ def solve_bar(inp, work, what):
     near(mean, expected, 0.01 * expected, f"tip displacement ({what})")
 
 
+def check_solve_bar(ictk, work, data):
+    """ictk solve on the bar's .vtu (E 210000 | 70000 side by side along x, nu 0.3) compressed by
+    d = 0.001 along z (H = 0.2): iso-strain, so the apparent modulus is the Voigt bound 140000 and
+    each block carries sigma_zz = -E d / H; the top platen's nodes move by -d."""
+    model = os.path.join(data, "Models", "bar", "two_material_bar.json")
+    mesh = os.path.join(work, "bar.vtu")
+    run(ictk, ["tetra", model, "-o", mesh, "--backend", "tetgen", "--size", "0.05"])
+    out = os.path.join(work, "solved.vtu")
+    # Scripts/setup installs ccx: without it the install is broken, not the test.
+    if not shutil.which("ccx"):
+        sys.exit("FAIL: ccx not found: install calculix-ccx (Scripts/setup)")
+    report = json.loads(run(ictk, ["solve", mesh, "--compression", "0.001", "-o", out, "--json"]).stdout)
+    near(report["voigt_modulus"], 140000, 1e-6, "Voigt bound")
+    near(report["reuss_modulus"], 1 / (0.5 / 210000 + 0.5 / 70000), 1e-6, "Reuss bound")
+    near(report["apparent_modulus"], 140000, 1e-4 * 140000, "apparent modulus")
+    near(report["force"], 140000 * 0.4 * 0.001 / 0.2, 1e-2, "platen force")
+    if report["materials"] != 2:
+        sys.exit(f"FAIL: {report['materials']} deck materials, not 2")
+    for f in ("compression.inp", "compression.frd", "compression.dat", "compression.log"):
+        if not os.path.exists(os.path.join(work, "solved-ccx", f)):
+            sys.exit(f"FAIL: solved-ccx/{f} missing")
+    import vtk
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(out)
+    r.Update()
+    grid = r.GetOutput()
+    pd, cd = grid.GetPointData(), grid.GetCellData()
+    for name, components in (("displacement", 3), ("stress", 6), ("von_mises", 1), ("reaction_force", 3)):
+        a = pd.GetArray(name)
+        if a is None or a.GetNumberOfComponents() != components:
+            sys.exit(f"FAIL: point array {name} ({components} components) missing")
+    for name in ("MaterialId", "youngs_modulus", "deck_youngs_modulus", "deck_material"):
+        if cd.GetArray(name) is None:
+            sys.exit(f"FAIL: cell array {name} missing")
+    u, s, vm = pd.GetArray("displacement"), pd.GetArray("stress"), pd.GetArray("von_mises")
+    top = 0
+    for i in range(grid.GetNumberOfPoints()):
+        x, _, z = grid.GetPoint(i)
+        if abs(z - 0.2) < 1e-9:
+            near(u.GetComponent(i, 2), -0.001, 1e-9, f"u_z of top node {i}")
+            top += 1
+        # Away from the interface each block is in uniaxial stress E d / H.
+        if x < 0.9 or x > 1.1:
+            e = 210000 if x < 1 else 70000
+            near(s.GetComponent(i, 2), -e * 0.001 / 0.2, 1e-3 * e * 0.005, f"sigma_zz at node {i}")
+            near(vm.GetTuple1(i), e * 0.001 / 0.2, 1e-3 * e * 0.005, f"von Mises at node {i}")
+    if top < 10:
+        sys.exit(f"FAIL: {top} nodes on the top platen")
+    print(f"ictk solve bar: {grid.GetNumberOfCells()} tetrahedra, apparent modulus "
+          f"{report['apparent_modulus']:.2f} (Voigt 140000), ccx {report['ccx_seconds']:.3f} s")
+    # A solver that is not there: a clear error, no output.
+    p = run(ictk, ["solve", mesh, "--compression", "0.001", "-o", os.path.join(work, "none.vtu"),
+                   "--ccx", "ictk-no-such-ccx"], check=False)
+    if p.returncode != 2 or "'ictk-no-such-ccx' was not found" not in p.stderr or "calculix-ccx" not in p.stderr:
+        sys.exit(f"FAIL: missing ccx: exit {p.returncode}, {p.stderr}")
+    if os.path.exists(os.path.join(work, "none.vtu")):
+        sys.exit("FAIL: none.vtu written without a solver")
+
+
 def read_frame(path):
     """A .vtpc frame of `ictk run`: {cell name: (leaf, instance)}."""
     import vtk
@@ -833,8 +893,8 @@ def check_study(ictk, work, data):
     for c in range(0, grid.GetNumberOfCells(), 101):
         if labels.GetTuple1(c) == 4 and modulus.GetTuple1(c) != 110000:
             sys.exit(f"FAIL: implant tetrahedron {c} has modulus {modulus.GetTuple1(c)}")
-    if report["modulus_bins"] < 10:
-        sys.exit(f"FAIL: only {report['modulus_bins']} modulus bins from the scan")
+    if report["deck_materials"] < 10:
+        sys.exit(f"FAIL: only {report['deck_materials']} deck materials from the scan's moduli")
 
     study = json.load(open(model))
 
@@ -911,6 +971,10 @@ def main():
         return
     if check == "tetra-bar":
         check_tetra_bar(ictk, work, rest[0])
+        print("OK")
+        return
+    if check == "solve-bar":
+        check_solve_bar(ictk, work, rest[0])
         print("OK")
         return
     if check in ("run-disk", "run-errors", "run-default"):

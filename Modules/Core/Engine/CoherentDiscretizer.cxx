@@ -29,9 +29,7 @@ bool sameAffine(const Affine& a, const Affine& b)
 
 bool hasWorldParts(const PlacedShape& s)
 {
-  return std::any_of(s.parts.begin(), s.parts.end(),
-    [](const ShapePart& p)
-    { return p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union; });
+  return std::any_of(s.parts.begin(), s.parts.end(), geometry::combinesCells);
 }
 
 std::vector<frep::Point3>& pointsOf(complex::CellMesh& m)

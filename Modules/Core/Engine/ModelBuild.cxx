@@ -55,6 +55,7 @@ void ModelState::build()
       for (const CellDef& def : section.defs)
         if (!cellIndex.count(def.name.text))
           buildCell(def);
+  checkSpaceTimeBlends();
   for (const ParamDecl& p : model.stateParameters)
     if (p.kind == ParamDecl::Kind::Typed)
     {
@@ -107,6 +108,32 @@ void ModelState::build()
   if (!any)
     fail({ 1, 1 }, "the model has no IC instance (only templates)");
   buildStepper();
+}
+
+void ModelState::checkSpaceTimeBlends() const
+{
+  // A space-time blend of two k-dimensional cells is a (k + 1)-dimensional T-cell (thesis 5.3.1:
+  // "two 3D cells used as input, result is 4D").
+  for (const CellSpec& c : cells)
+  {
+    if (!c.operands || c.operands->kind != ShapePart::Kind::SpaceTimeBlend)
+      continue;
+    for (const std::string& name : { c.operands->a, c.operands->b })
+    {
+      const auto it = cellIndex.find(name);
+      if (it == cellIndex.end())
+        fail(c.operands->pos, "spaceTimeBlendCells: no cell named " + name);
+      const CellSpec& o = cells[it->second];
+      const int k = spaceDimension(o);
+      if (k < 2 || c.dimension != k + 1)
+        fail(c.operands->pos,
+          "the cell " + c.name + " blends " + name + ", a " + std::to_string(k) +
+            "D cell, in space-time" +
+            (k < 2 ? ": its operands must be 2D or 3D cells"
+                   : ", so it is dim = " + std::to_string(k + 1) + "D, its cross-sections " +
+                  std::to_string(k) + "D"));
+    }
+  }
 }
 
 void ModelState::buildTimespans()
@@ -341,7 +368,11 @@ void ModelState::buildCell(const CellDef& def)
   // A space-time cell (thesis 5.3) has one dimension more than its cross-sections: 4D for a
   // field of x, y, z and t, 3D for one of x, y and t. Anything else declared 4D would be a 3D
   // shape that no time moves, which is not what the model says.
-  if (c.spaceTime)
+  if (c.spaceTime && c.operands)
+  {
+    // spaceTimeBlendCells: its operands' dimensions are checked once every cell is built.
+  }
+  else if (c.spaceTime)
   {
     const int expected = c.parts[c.fieldPart].fieldDimension + 1;
     if (c.dimension != expected)

@@ -8,6 +8,8 @@
 #include "Lang/HyperFun.h"
 #include "Lang/MeshFile.h"
 
+#include "FRep/Operations.h"
+
 #include <cmath>
 
 namespace ictk::engine
@@ -175,7 +177,27 @@ void operandsShape(const ShapeCall& s)
   if (args.size() < 2 || args[0].type != Value::Type::Cell || args[1].type != Value::Type::Cell)
     s.fail(s.name + " takes two cells");
   s.c.operands = CellSpec::Operands{ kind, args[0].text, args[1].text,
-    kind == ShapePart::Kind::Blend ? s.size(2) : 0.0 };
+    kind == ShapePart::Kind::Blend ? s.size(2) : 0.0, {}, s.expr.pos };
+}
+
+/// spaceTimeBlendCells(A, B, t0, t1, a0, a1, a2, a3): a space-time cell (thesis 5.3.1) whose
+/// cross-section at global time t is the blend's slice there.
+void spaceTimeBlendShape(const ShapeCall& s)
+{
+  operandsShape<ShapePart::Kind::SpaceTimeBlend>(s);
+  frep::SpaceTimeBlendParameters& p = s.c.operands->spaceTime;
+  double* slots[] = { &p.t0, &p.t1, &p.a0, &p.a1, &p.a2, &p.a3 };
+  for (std::size_t i = 0; i < 6; ++i)
+    *slots[i] = s.num(i + 2);
+  try
+  {
+    frep::validateSpaceTimeBlend(s.name.c_str(), p);
+  }
+  catch (const std::exception& e)
+  {
+    s.fail(e.what());
+  }
+  s.c.spaceTime = true;
 }
 
 /// The engine's builders of the shape constructors (lang::icm::shapeBuiltins()).
@@ -192,6 +214,7 @@ const std::pair<ShapeId, ShapeConstructor> kShapes[] = {
   { ShapeId::Sphere, roundShape<ShapePart::Kind::Sphere> },
   { ShapeId::Blend, operandsShape<ShapePart::Kind::Blend> },
   { ShapeId::Union, operandsShape<ShapePart::Kind::Union> },
+  { ShapeId::SpaceTimeBlend, spaceTimeBlendShape },
 };
 
 } // namespace

@@ -80,12 +80,15 @@ struct CellSpec
   /// object (thesis 5.3, `dim = 4D` or `3D`) whose shape at global time t is its cross-section
   /// there (makeCrossSection(shape, globalT)): the field with T bound to t.
   bool spaceTime = false;
-  /// blend(A, B, amount) / union(A, B): operands are cells, placed when the shape is needed.
+  /// blend(A, B, amount) / union(A, B) / spaceTimeBlendCells(A, B, t0, t1, ...): operands are
+  /// cells, placed when the shape is needed.
   struct Operands
   {
     ShapePart::Kind kind = ShapePart::Kind::Union;
     std::string a, b;
     double amount = 0.0;
+    frep::SpaceTimeBlendParameters spaceTime; ///< SpaceTimeBlend only
+    Pos pos;                                  ///< the constructor's call
   };
   std::optional<Operands> operands;
   std::vector<ParamSpec> params;
@@ -190,6 +193,8 @@ struct ModelState
   // ---- building --------------------------------------------------------------------------
   void build();
   void buildTimespans();
+  /// Every spaceTimeBlendCells cell is one dimension above its two operands.
+  void checkSpaceTimeBlends() const;
   void buildAnimations();
   void buildEvents();
   void buildCell(const CellDef& def);

@@ -173,9 +173,12 @@ PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
   if (c.operands && !s.shapes.count(cell))
   {
     ShapePart part;
+    PlacedShapePtr a = shapeOf(c.operands->a, depth + 1), b = shapeOf(c.operands->b, depth + 1);
+    if (c.operands->kind == ShapePart::Kind::SpaceTimeBlend)
+      part = geometry::spaceTimeBlendPart(a, b, c.operands->spaceTime, shapeTime());
     part.kind = c.operands->kind;
-    part.operandA = shapeOf(c.operands->a, depth + 1);
-    part.operandB = shapeOf(c.operands->b, depth + 1);
+    part.operandA = a;
+    part.operandB = b;
     part.amount = c.operands->amount;
     part.bounds = c.domain;
     shape->parts.push_back(part);

@@ -841,23 +841,26 @@ Shape metamorphosis(const Shape& a, const Shape& b, double t0, double t1)
   return Shape((1.0 - s) * a.function() + s * b.function(), d, binaryLabel("metamorphosis", a, b));
 }
 
-Shape spaceTimeBlend(const Shape& a, const Shape& b, double t0, double t1, double a0, double a1,
-  double a2, double a3, double overlap)
+void validateSpaceTimeBlend(const char* operation, const SpaceTimeBlendParameters& p)
 {
-  requireSameDomain("spaceTimeBlend", a, b);
-  requireFinite("spaceTimeBlend", "t0", t0);
-  requireFinite("spaceTimeBlend", "t1", t1);
-  if (!(t0 < t1))
+  requireFinite(operation, "t0", p.t0);
+  requireFinite(operation, "t1", p.t1);
+  if (!(p.t0 < p.t1))
   {
-    invalid("spaceTimeBlend",
-      "parameters must satisfy t0 < t1, got t0 = " + number(t0) + ", t1 = " + number(t1));
+    invalid(operation,
+      "parameters must satisfy t0 < t1, got t0 = " + number(p.t0) + ", t1 = " + number(p.t1));
   }
-  if (!(overlap > 0.0 && overlap <= 0.5))
+  if (!(p.overlap > 0.0 && p.overlap <= 0.5))
   {
-    invalid("spaceTimeBlend", "parameter overlap must lie in (0, 0.5], got " + number(overlap));
+    invalid(operation, "parameter overlap must lie in (0, 0.5], got " + number(p.overlap));
   }
-  requireBoundedBlendScales("spaceTimeBlend", a0, a1, a2, a3);
-  const Domain d = withTime("spaceTimeBlend", a);
+  requireBoundedBlendScales(operation, p.a0, p.a1, p.a2, p.a3);
+}
+
+Expr spaceTimeBlendExpr(
+  const Expr& f1, const Expr& f2, const Expr& t, const SpaceTimeBlendParameters& p)
+{
+  validateSpaceTimeBlend("spaceTimeBlend", p);
   // Half-cylinders and bounding slab after thesis_ch5_6.md [EXT] "Space-time blending construction"
   // (F1 = f1 & (t0 - t), F2 = f2 & (t - t1), F3 = (t - t0) & (t1 - t)), with one change: the cuts
   // are moved into the slab by overlap (t1 - t0). With the cuts exactly on the slab faces, r -> 1
@@ -865,14 +868,27 @@ Shape spaceTimeBlend(const Shape& a, const Shape& b, double t0, double t1, doubl
   // no material yet) and the morph would jump. With the cuts inside, F3 <= 0 for t <= t0 gives F =
   // R-union(F1, F2) with F2 < 0 and tA - t > 0, whose sign is exactly sign(f1) (and likewise
   // sign(f2) for t >= t1).
-  const double tA = t0 + overlap * (t1 - t0);
-  const double tB = t1 - overlap * (t1 - t0);
-  const Expr t = Expr::t();
-  const Expr F1 = rIntersection(a.function(), tA - t, 0.0);
-  const Expr F2 = rIntersection(b.function(), t - tB, 0.0);
-  const Expr F3 = rIntersection(t - t0, t1 - t, 0.0);
-  return Shape(
-    boundedBlendExpr(F1, F2, F3, a0, a1, a2, a3), d, binaryLabel("spaceTimeBlend", a, b));
+  const double tA = p.t0 + p.overlap * (p.t1 - p.t0);
+  const double tB = p.t1 - p.overlap * (p.t1 - p.t0);
+  const Expr F1 = rIntersection(f1, tA - t, 0.0);
+  const Expr F2 = rIntersection(f2, t - tB, 0.0);
+  const Expr F3 = rIntersection(t - p.t0, p.t1 - t, 0.0);
+  return boundedBlendExpr(F1, F2, F3, p.a0, p.a1, p.a2, p.a3);
+}
+
+Shape spaceTimeBlend(const Shape& a, const Shape& b, const SpaceTimeBlendParameters& p)
+{
+  requireSameDomain("spaceTimeBlend", a, b);
+  validateSpaceTimeBlend("spaceTimeBlend", p);
+  const Domain d = withTime("spaceTimeBlend", a);
+  return Shape(spaceTimeBlendExpr(a.function(), b.function(), Expr::t(), p), d,
+    binaryLabel("spaceTimeBlend", a, b));
+}
+
+Shape spaceTimeBlend(const Shape& a, const Shape& b, double t0, double t1, double a0, double a1,
+  double a2, double a3, double overlap)
+{
+  return spaceTimeBlend(a, b, SpaceTimeBlendParameters{ t0, t1, a0, a1, a2, a3, overlap });
 }
 
 } // namespace ictk::frep

@@ -122,15 +122,35 @@ Shape metamorphosis(const Shape& a, const Shape& b, double s);
 /// Time-dependent linear metamorphosis: s(t) = clamp((t - t0) / (t1 - t0), 0, 1); the shapes must
 /// not use t, and the result lives on their domain extended with t.
 Shape metamorphosis(const Shape& a, const Shape& b, double t0, double t1);
-/// Space-time blending (thesis 5.3, L1161-L1171, EXT L3074-L3083; Pasko, Pasko & Kunii 2004):
-/// two shapes of one time-free domain (X, XY or XYZ) become half-cylinders in the domain extended
-/// with t,
+/// The parameters of space-time blending: the transition interval [t0, t1], the bounded blend's
+/// amplitude a0 (added material, > 0 in the thesis) and scales a1, a2 (operands) and a3 (the
+/// bounding time slab), and how far the half-cylinders reach into the slab, as a fraction of
+/// t1 - t0 (0 < overlap <= 0.5).
+struct SpaceTimeBlendParameters
+{
+  double t0 = 0, t1 = 1;
+  double a0 = 1, a1 = 1, a2 = 1, a3 = 1;
+  double overlap = 0.25;
+};
+/// Throws std::invalid_argument, naming `operation` and the parameter, unless t0 < t1 (both
+/// finite), 0 < overlap <= 0.5 and a0..a3 are finite with a1, a2, a3 non-zero.
+void validateSpaceTimeBlend(const char* operation, const SpaceTimeBlendParameters& p);
+/// Space-time blending (thesis 5.3, L1161-L1171, EXT L3074-L3083; Pasko, Pasko & Kunii 2004) of
+/// two fields f1, f2 that do not depend on t, with `t` the time coordinate (Expr::t(), a
+/// HyperFun model's x[4], or a constant for one cross-section): the fields become half-cylinders
+/// in space-time,
 ///   F1 = f1 R-intersect (tA - t),  F2 = f2 R-intersect (t - tB),
 /// with tA = t0 + overlap (t1 - t0), tB = t1 - overlap (t1 - t0), and are bounded-blended with the
 /// time slab F3 = (t - t0) R-intersect (t1 - t) as bounding solid. Hence for t <= t0 the slice has
 /// exactly the sign of f1 and for t >= t1 exactly the sign of f2; the transition (with added
 /// material a0) happens inside (t0, t1). The half-cylinders reach into the slab (overlap > 0) so
-/// that the slices vary continuously in t. 0 < overlap <= 0.5, t0 < t1.
+/// that the slices vary continuously in t. Validates p (validateSpaceTimeBlend).
+Expr spaceTimeBlendExpr(
+  const Expr& f1, const Expr& f2, const Expr& t, const SpaceTimeBlendParameters& p);
+/// spaceTimeBlendExpr of two shapes of one time-free domain (X, XY or XYZ); the result lives on
+/// their domain extended with t.
+Shape spaceTimeBlend(const Shape& a, const Shape& b, const SpaceTimeBlendParameters& p);
+/// The same with the parameters spelled out.
 Shape spaceTimeBlend(const Shape& a, const Shape& b, double t0, double t1, double a0, double a1,
   double a2, double a3, double overlap = 0.25);
 

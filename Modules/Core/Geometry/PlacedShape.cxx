@@ -5,6 +5,7 @@
 
 #include "Geometry/Prepared.h"
 
+#include "FRep/Tape.h"
 #include "FRep/Vector.h"
 
 #include <algorithm>
@@ -38,6 +39,7 @@ int partDimension(const ShapePart& p)
       return p.fieldDimension == 2 ? 2 : 3;
     case ShapePart::Kind::Blend:
     case ShapePart::Kind::Union:
+    case ShapePart::Kind::SpaceTimeBlend:
       return std::max(
         p.operandA ? shapeDimension(*p.operandA) : 0, p.operandB ? shapeDimension(*p.operandB) : 0);
   }
@@ -188,9 +190,14 @@ void validate(const PlacedShape& s, int depth)
         break;
       case ShapePart::Kind::Blend:
       case ShapePart::Kind::Union:
+      case ShapePart::Kind::SpaceTimeBlend:
         if (!p.operandA || !p.operandB)
         {
           fail(s, "a blend or union needs two operands");
+        }
+        if (p.kind == ShapePart::Kind::SpaceTimeBlend && !p.blend)
+        {
+          fail(s, "a space-time blend needs its function (made by spaceTimeBlendPart)");
         }
         validate(*p.operandA, depth + 1);
         validate(*p.operandB, depth + 1);
@@ -377,6 +384,20 @@ bool Affine::isIdentity() const
   return a == std::array<double, 9>{ 1, 0, 0, 0, 1, 0, 0, 0, 1 } && b == Vec3{ 0, 0, 0 };
 }
 
+ShapePart spaceTimeBlendPart(
+  PlacedShapePtr a, PlacedShapePtr b, const frep::SpaceTimeBlendParameters& p, double time)
+{
+  ShapePart part;
+  part.kind = ShapePart::Kind::SpaceTimeBlend;
+  part.operandA = std::move(a);
+  part.operandB = std::move(b);
+  part.spaceTime = p;
+  part.time = time;
+  part.blend = frep::tapeField(frep::Tape::compile(
+    frep::spaceTimeBlendExpr(frep::Expr::x(), frep::Expr::y(), frep::Expr(time), p)));
+  return part;
+}
+
 double PlacedShape::value(const Vec3& world) const
 {
   validate(*this);
@@ -435,15 +456,20 @@ frep::Box3 PlacedShape::worldBounds() const
         break;
       case ShapePart::Kind::Blend:
       case ShapePart::Kind::Union:
+      case ShapePart::Kind::SpaceTimeBlend:
       {
         if (!p.operandA || !p.operandB)
         {
           break;
         }
         // The blend's bump reaches about 1.7 a0 beyond the operands where their fields are
-        // distances (a0 / (1 + 2 d^2) = (2 - sqrt 2) d); 2 a0 covers it.
-        add(padded(joinBoxes(p.operandA->worldBounds(), p.operandB->worldBounds()),
-          p.kind == ShapePart::Kind::Blend ? 2 * p.amount : 0.0));
+        // distances (a0 / (1 + 2 d^2) = (2 - sqrt 2) d); 2 a0 covers it. The bounded blend's
+        // displacement is at most a0 too (disp <= 1), and its half-cylinders are at most the
+        // operands (an R-intersection is at most either argument).
+        const double bump = p.kind == ShapePart::Kind::Blend ? p.amount
+          : p.kind == ShapePart::Kind::SpaceTimeBlend        ? std::abs(p.spaceTime.a0)
+                                                             : 0.0;
+        add(padded(joinBoxes(p.operandA->worldBounds(), p.operandB->worldBounds()), 2 * bump));
         break;
       }
       default:

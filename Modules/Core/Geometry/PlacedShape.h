@@ -13,6 +13,7 @@
 // (PlacedShape::value, worldField) is >= 0 inside, as every FRep field.
 
 #include "FRep/Field.h"
+#include "FRep/Operations.h"
 #include "FRep/Vector.h"
 
 #include <array>
@@ -67,7 +68,9 @@ struct ShapePart
     Field,     ///< {field >= 0} (3D; 2D in z = 0 when fieldDimension == 2), inside `bounds`
     Blend,     ///< the blended union of two other cells' placed shapes (world coordinates)
     Union,     ///< the union of two other cells' placed shapes (world coordinates)
-    Mesh       ///< the triangle surface `triangles` over `points` (a .obj/.off B-cell)           2D
+    SpaceTimeBlend, ///< the cross-section at `time` of the space-time blend of two other cells'
+                    ///< placed shapes (world coordinates; frep::spaceTimeBlendExpr)
+    Mesh ///< the triangle surface `triangles` over `points` (a .obj/.off B-cell)           2D
   };
   Kind kind = Kind::Point;
   std::vector<Vec3> points;
@@ -83,7 +86,27 @@ struct ShapePart
   /// blending strength (0 = the plain union, max(f1, f2)).
   PlacedShapePtr operandA, operandB;
   double amount = 0.0;
+  /// SpaceTimeBlend: the blend's parameters, the time of the cross-section, and the
+  /// cross-section's function g(fa, fb) of the operands' values as a field of (x, y) = (fa, fb)
+  /// (compiled once; made by spaceTimeBlendPart).
+  frep::SpaceTimeBlendParameters spaceTime;
+  double time = 0.0;
+  frep::FieldPtr blend;
 };
+
+/// Blend, Union and SpaceTimeBlend parts are made of two other cells' placed shapes (world
+/// coordinates), not of local geometry.
+inline bool combinesCells(const ShapePart& p)
+{
+  return p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union ||
+    p.kind == ShapePart::Kind::SpaceTimeBlend;
+}
+
+/// The SpaceTimeBlend part of two placed shapes: the cross-section at `time` of their space-time
+/// blend with parameters `p` (frep::spaceTimeBlendExpr; throws std::invalid_argument for bad
+/// parameters). `bounds` is left empty.
+ShapePart spaceTimeBlendPart(
+  PlacedShapePtr a, PlacedShapePtr b, const frep::SpaceTimeBlendParameters& p, double time);
 
 /// A cell's shape placed in the world.
 struct PlacedShape

@@ -37,6 +37,23 @@ double blendUnion(double f1, double f2, double a0)
 }
 // The R-function part is nondecreasing in each argument; the bump is bounded by the ranges of
 // f1^2 + f2^2.
+/// An operand's value as the space-time blend's function takes it: -Inf (outside every part,
+/// or NaN) and huge values would make its squares overflow; beyond 1e150 the cross-section's sign
+/// no longer changes.
+double operandValue(double f)
+{
+  return std::isnan(f) ? -1e150 : std::clamp(f, -1e150, 1e150);
+}
+
+/// The cross-section's value g(fa, fb) and its partial derivatives (dg/dfa, dg/dfb, 0).
+double spaceTimeSlice(const PreparedPart& pp, double fa, double fb, Vec3& dg)
+{
+  frep::Point3 grad;
+  const double v = pp.eval->gradient({ operandValue(fa), operandValue(fb), 0 }, grad);
+  dg = { grad[0], grad[1], 0 };
+  return std::isnan(v) ? -Inf : v;
+}
+
 Interval blendUnion(Interval f1, Interval f2, double a0)
 {
   if (a0 <= 0)
@@ -114,6 +131,13 @@ Prepared::Prepared(const PlacedShape& s)
       case ShapePart::Kind::Union:
         pp.a = std::make_unique<Prepared>(*part.operandA);
         pp.b = std::make_unique<Prepared>(*part.operandB);
+        analytic = false;
+        break;
+      case ShapePart::Kind::SpaceTimeBlend:
+        pp.a = std::make_unique<Prepared>(*part.operandA);
+        pp.b = std::make_unique<Prepared>(*part.operandB);
+        // g(fa, fb) as a field of (x, y): its values, bounds and gradient are the kernel's.
+        pp.eval = part.blend->evaluator();
         analytic = false;
         break;
       case ShapePart::Kind::Box:
@@ -241,6 +265,11 @@ double Prepared::partValue(const PreparedPart& pp, Vec3 w) const
     const double fa = pp.a->value(w), fb = pp.b->value(w);
     return p.kind == ShapePart::Kind::Union ? std::max(fa, fb) : blendUnion(fa, fb, p.amount);
   }
+  if (p.kind == ShapePart::Kind::SpaceTimeBlend)
+  {
+    Vec3 unused;
+    return spaceTimeSlice(pp, pp.a->value(w), pp.b->value(w), unused);
+  }
   Vec3 l = pp.toLocal.apply(w);
   if (pp.dim <= 2)
   {
@@ -304,6 +333,13 @@ Interval Prepared::partBound(const PreparedPart& pp, const Box3& w) const
   {
     const Interval fa = pp.a->bound(w), fb = pp.b->bound(w);
     return p.kind == ShapePart::Kind::Union ? ivMax(fa, fb) : blendUnion(fa, fb, p.amount);
+  }
+  if (p.kind == ShapePart::Kind::SpaceTimeBlend)
+  {
+    const Interval fa = pp.a->bound(w), fb = pp.b->bound(w);
+    const Interval g = pp.eval->bound({ { operandValue(fa.lo), operandValue(fb.lo), 0 },
+      { operandValue(fa.hi), operandValue(fb.hi), 0 } });
+    return g.empty() || g.maybeNaN ? iv(-Inf, Inf) : g;
   }
   Box3 l = mapBox(pp.toLocal, w);
   if (pp.dim <= 2)
@@ -403,6 +439,17 @@ double Prepared::partGradient(const PreparedPart& pp, Vec3 w, Vec3& g) const
       g[i] = da * ga[i] + db * gb[i];
     }
     return blendUnion(fa, fb, p.amount);
+  }
+  if (p.kind == ShapePart::Kind::SpaceTimeBlend)
+  {
+    Vec3 ga, gb, dg;
+    const double fa = pp.a->gradient(w, ga), fb = pp.b->gradient(w, gb);
+    const double v = spaceTimeSlice(pp, fa, fb, dg);
+    for (int i = 0; i < 3; ++i)
+    {
+      g[i] = dg[0] * ga[i] + dg[1] * gb[i];
+    }
+    return v;
   }
   Vec3 l = pp.toLocal.apply(w);
   if (pp.dim <= 2)

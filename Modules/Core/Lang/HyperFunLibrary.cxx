@@ -586,6 +586,21 @@ const std::unordered_map<std::string, Compiler::Handler>& Compiler::library()
   };
   L["hfblenduni"] = blend(true);
   L["hfblendint"] = blend(false);
+  // hfSpaceTimeBlend(f1, f2, t, t0, t1, a0, a1, a2, a3) (ICTK's, thesis 5.3.1): t is the time
+  // coordinate, normally x[4]; Operations.h spaceTimeBlendExpr.
+  L["hfspacetimeblend"] = [=](Frame& f, const ExprNode& n)
+  {
+    args(n, 9);
+    const Expr f1 = eval(f, n.kids[0]).e;
+    const Expr f2 = eval(f, n.kids[1]).e;
+    const Expr t = eval(f, n.kids[2]).e;
+    frep::SpaceTimeBlendParameters p;
+    double* slots[] = { &p.t0, &p.t1, &p.a0, &p.a1, &p.a2, &p.a3 };
+    for (std::size_t i = 0; i < 6; ++i)
+      *slots[i] = number(f, n, 3 + i);
+    count(40, n);
+    return plain(kernel(n, [&] { return frep::spaceTimeBlendExpr(f1, f2, t, p); }));
+  };
   L["hfshift3d"] = [=](Frame& f, const ExprNode& n)
   {
     args(n, 4);

@@ -143,6 +143,16 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
       "the blended union of two cells' shapes" },
     { Id::Union, { "union", 2, 2, "union(cellA, cellB)", "shape" }, 2,
       "the union of two cells' shapes" },
+    { Id::SpaceTimeBlend,
+      { "spaceTimeBlendCells", 8, 8,
+        "spaceTimeBlendCells(cellA, cellB, real t0, real t1, real a0, real a1, real a2, real a3)",
+        "shape" },
+      2,
+      "the space-time blend (thesis 5.3.1) of two cells' shapes of dimension k, a T-cell of "
+      "`dim` k + 1: at global time t its cross-section, cellA's shape until t0, cellB's from t1, "
+      "a blend of the two between, with the bounded blend's added material a0 and scales a1, a2 "
+      "(the operands') and a3 (the time slab's); no defaults: they depend on the shapes' "
+      "sizes and the interval's length" },
   };
   return table;
 }

@@ -108,6 +108,7 @@ enum class ShapeId
   Sphere,
   Blend,
   Union,
+  SpaceTimeBlend,
   Count ///< not a constructor: the number of them
 };
 
@@ -118,8 +119,8 @@ struct ShapeBuiltin
 {
   ShapeId id;
   Signature call;
-  /// How many leading arguments name cells (blend, union): the checker requires cell names there
-  /// and the engine passes them on as cells instead of evaluating them.
+  /// How many leading arguments name cells (blend, union, spaceTimeBlendCells): the checker
+  /// requires cell names there and the engine passes them on as cells instead of evaluating them.
   int cellArguments;
   const char* doc; ///< one line for docs/icm.md
 };

@@ -321,9 +321,10 @@ void Checker::shape(const ExprPtr& v, const CellMap& cells)
     }
     return;
   }
-  if (shape->id == ShapeId::Blend || shape->id == ShapeId::Union)
+  if (shape->cellArguments > 0)
   {
-    for (std::size_t i = 1; i < v->kids.size() && i <= 2; ++i)
+    for (std::size_t i = 1;
+         i < v->kids.size() && i <= static_cast<std::size_t>(shape->cellArguments); ++i)
     {
       const ExprPtr& a = v->kids[i];
       if (a->kind == Expr::Kind::Name && isMeshCell(a->text, &cells))

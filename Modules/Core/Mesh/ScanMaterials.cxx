@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -57,10 +58,8 @@ void setArray(TetMesh& mesh, const std::string& name, std::vector<double> values
   mesh.cellData.push_back({ name, 1, std::move(values) });
 }
 
-double unbinned(double hu, const ScanMaterialOptions& o)
-{
-  return std::max(o.minimumModulus, o.modulus(o.density(hu)));
-}
+/// The lowest density written (air's law density is below 0).
+constexpr double kMinimumDensity = 1e-3;
 
 } // namespace
 
@@ -74,30 +73,18 @@ double ModulusLaw::density(double modulus) const
   return modulus > a && b > 0 ? std::pow((modulus - a) / b, 1 / c) : NAN;
 }
 
-double binnedModulus(double modulus, const ScanMaterialOptions& options)
-{
-  if (options.binWidth == 0)
-  {
-    return modulus;
-  }
-  // The ladder's reference is 1 MPa: E_k = (1 + w)^k.
-  const double step = std::log1p(options.binWidth);
-  return std::exp(step * std::round(std::log(modulus) / step));
-}
-
 double scanModulus(double hu, const ScanMaterialOptions& options)
 {
-  return binnedModulus(unbinned(hu, options), options);
+  return std::max(options.minimumModulus, options.modulus(options.density(hu)));
 }
 
 void checkScanMaterials(
   const ScanMaterialOptions& options, const std::vector<std::string>& materialNames)
 {
-  if (!(options.binWidth >= 0) || !(options.minimumModulus > 0) ||
-    !(options.poissonRatio > -1 && options.poissonRatio < 0.5))
+  if (!(options.minimumModulus > 0) || !(options.poissonRatio > -1 && options.poissonRatio < 0.5))
   {
-    throw std::invalid_argument("scan materials: the bin width must be >= 0, the minimum modulus "
-                                "> 0 and the Poisson ratio in (-1, 0.5)");
+    throw std::invalid_argument("scan materials: the minimum modulus must be > 0 and the Poisson "
+                                "ratio in (-1, 0.5)");
   }
   for (const auto& name : options.scanCells)
   {
@@ -191,11 +178,12 @@ ScanMaterialSummary assignScanMaterials(
     hu.evaluator()->values(x.data(), y.data(), z.data(), h.data(), points.size());
   }
   ScanMaterialSummary summary;
-  std::set<double> bins;
+  summary.minModulus = scanned.empty() ? 0 : std::numeric_limits<double>::infinity();
   for (std::size_t s = 0; s < scanned.size(); ++s)
   {
     const std::size_t t = scanned[s];
-    double sum = 0;
+    double e = 0;
+    double rho = 0;
     for (std::size_t i = s * per; i < (s + 1) * per; ++i)
     {
       if (std::isnan(h[i]))
@@ -205,18 +193,15 @@ ScanMaterialSummary assignScanMaterials(
           << points[i][2] << ") in tetrahedron " << t;
         throw std::invalid_argument(m.str());
       }
-      sum += unbinned(h[i], options);
+      e += scanModulus(h[i], options);
+      rho += options.density(h[i]);
     }
-    modulus[t] = binnedModulus(sum / static_cast<double>(per), options);
-    const double rho = options.modulus.density(modulus[t]);
-    // The floor's elements (and laws with a > 0 below it) keep the law's own density.
-    density[t] = std::isfinite(rho) ? rho : std::max(options.density(h[s * per]), 1e-3);
+    modulus[t] = e / static_cast<double>(per);
+    density[t] = std::max(kMinimumDensity, rho / static_cast<double>(per));
     poisson[t] = options.poissonRatio;
-    bins.insert(modulus[t]);
+    summary.minModulus = std::min(summary.minModulus, modulus[t]);
+    summary.maxModulus = std::max(summary.maxModulus, modulus[t]);
   }
-  summary.bins = bins.size();
-  summary.minModulus = bins.empty() ? 0 : *bins.begin();
-  summary.maxModulus = bins.empty() ? 0 : *bins.rbegin();
   setArray(mesh, "label", std::move(label));
   setArray(mesh, "density", std::move(density));
   setArray(mesh, "youngs_modulus", std::move(modulus));

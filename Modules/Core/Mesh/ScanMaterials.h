@@ -7,7 +7,7 @@
 //
 // The laws, chosen by the user:
 //     density  rho = a + b HU                (g/cm^3)
-//     modulus  E   = a + b rho^c             (MPa; rho below 0 counts as 0)
+//     modulus  E   = a + b rho^c             (MPa; rho below 0 counts as 0; at least a floor)
 // Defaults: rho = 1 + 0.001 HU (the water-equivalent scale that defines HU: water 1 g/cm^3 at
 // 0 HU; uncalibrated, a phantom calibration of the scanner should replace it) and
 // E = 6850 rho^1.49 (Morgan, Bayraktar and Keaveny 2003, J. Biomech. 36:897, trabecular bone,
@@ -18,10 +18,9 @@
 // of one midpoint subdivision, 32 points of equal weight; Bonemat's default integrates E rather
 // than HU, so does this).
 //
-// Binning: so that a solver deck has a few materials, not one per element, moduli are rounded to
-// a geometric ladder E_k = E_ref (1 + w)^k (w = binWidth, 1 % by default: every binned modulus is
-// within w/2 relative of the sampled one); the density of a binned element is the law's density
-// of the binned modulus, so each bin is one (E, rho) pair.
+// Binning, so that a solver deck has a few materials and not one per element, is the deck's
+// (Writers.h deckMaterials, 1 % in ln E by default): the arrays here keep every element's own
+// values. A density below 0.001 g/cm^3 (air) is written as 0.001, so a solver accepts it.
 
 #include "FRep/Field.h"
 #include "Mesh/TetMesh.h"
@@ -71,8 +70,6 @@ struct ScanMaterialOptions
   /// Poisson ratio of the scan's elements.
   double poissonRatio = 0.3;
   ScanSampling sampling = ScanSampling::Integrated;
-  /// Relative width of a modulus bin (0: no binning).
-  double binWidth = 0.01;
   /// The lowest modulus a scan element gets (air and fat give rho <= 0), MPa.
   double minimumModulus = 1;
   /// The names of the cells (TetMesh::materialNames) whose elements come from the scan.
@@ -83,8 +80,7 @@ struct ScanMaterialOptions
 
 struct ScanMaterialSummary
 {
-  /// Distinct (modulus, density) pairs of the scan's elements after binning.
-  std::size_t bins = 0;
+  /// The scan elements' moduli (0 when there are none).
   double minModulus = 0;
   double maxModulus = 0;
 };
@@ -93,8 +89,8 @@ struct ScanMaterialSummary
 /// 1-based, TetMesh::materials), "density", "youngs_modulus" and "poisson_ratio". `hu` is the
 /// scan's field (Hounsfield units at a point; voxel::voxelField(grid, 0) gives it). Throws
 /// std::invalid_argument for a cell that is neither a scan cell nor a fixed one (naming it), a
-/// name in the options that is no cell of the mesh, bad options (a non-positive bin width or
-/// minimum modulus, a Poisson ratio outside (-1, 0.5)), or a HU value that is NaN (naming the
+/// name in the options that is no cell of the mesh, bad options (a non-positive minimum modulus,
+/// a Poisson ratio outside (-1, 0.5)), or a HU value that is NaN (naming the
 /// element and the point).
 ScanMaterialSummary assignScanMaterials(
   TetMesh& mesh, const frep::Field& hu, const ScanMaterialOptions& options);
@@ -104,11 +100,8 @@ ScanMaterialSummary assignScanMaterials(
 void checkScanMaterials(
   const ScanMaterialOptions& options, const std::vector<std::string>& materialNames);
 
-/// The modulus of one HU value under the options' laws, floor and binning (what
-/// assignScanMaterials gives an element whose sampled HU is `hu`, in centroid mode).
+/// The modulus of one HU value under the options' laws and floor (what assignScanMaterials gives
+/// an element whose sampled HU is `hu`, in centroid mode).
 double scanModulus(double hu, const ScanMaterialOptions& options);
-
-/// The binned value of modulus E (options.binWidth; E itself when it is 0).
-double binnedModulus(double modulus, const ScanMaterialOptions& options);
 
 } // namespace ictk::mesh

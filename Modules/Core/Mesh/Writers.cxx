@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -401,15 +402,106 @@ std::vector<SolidMaterial> solidMaterials(const TetMesh& mesh)
   return out;
 }
 
+std::vector<DeckMaterial> deckMaterials(const TetMesh& mesh, double binWidth)
+{
+  if (!(binWidth > 0))
+  {
+    throw std::invalid_argument(
+      "the modulus bin width must be positive (in ln E), not " + std::to_string(binWidth));
+  }
+  const std::vector<SolidMaterial> cells = solidMaterials(mesh);
+  const auto groups = byMaterial(mesh);
+  const TetArray* e = findArray(mesh, "youngs_modulus");
+  const TetArray* nu = findArray(mesh, "poisson_ratio");
+  const TetArray* rho = findArray(mesh, "density");
+  auto volume = [&](std::size_t t)
+  {
+    const auto& k = mesh.tetrahedra[t];
+    return tetShape(mesh.points[k[0]], mesh.points[k[1]], mesh.points[k[2]], mesh.points[k[3]])
+      .volume;
+  };
+  std::set<std::string> taken;
+  for (const auto& name : abaqusSetNames(mesh))
+  {
+    taken.insert(upper(name));
+  }
+  std::vector<DeckMaterial> out;
+  for (const SolidMaterial& cell : cells)
+  {
+    const auto& tets = groups[static_cast<std::size_t>(cell.material - 1)];
+    double lowest = std::numeric_limits<double>::infinity(), highest = 0;
+    for (auto t : tets)
+    {
+      lowest = std::min(lowest, e->values[t]);
+      highest = std::max(highest, e->values[t]);
+    }
+    // The bin of each tetrahedron, counted from the cell's smallest modulus; one bin: the cell.
+    std::map<long long, std::vector<std::size_t>> bins;
+    if (std::log(highest / lowest) >= binWidth)
+    {
+      for (auto t : tets)
+      {
+        bins[static_cast<long long>(std::floor(std::log(e->values[t] / lowest) / binWidth))]
+          .push_back(t);
+      }
+    }
+    if (bins.size() <= 1)
+    {
+      DeckMaterial d;
+      d.material = cell.material;
+      d.setName = cell.setName;
+      d.tetrahedra = tets;
+      for (auto t : tets)
+      {
+        d.volume += volume(t);
+      }
+      d.youngsModulus = cell.youngsModulus;
+      d.poissonRatio = cell.poissonRatio;
+      d.density = cell.density;
+      out.push_back(std::move(d));
+      continue;
+    }
+    for (auto& [k, members] : bins)
+    {
+      DeckMaterial d;
+      d.material = cell.material;
+      d.bin = static_cast<int>(k + 1);
+      const std::string suffix = "_E" + std::to_string(d.bin);
+      const std::string base = cell.setName.substr(0, 76 - suffix.size()) + suffix;
+      d.setName = base;
+      for (int n = 2; taken.count(upper(d.setName)); ++n)
+      {
+        d.setName = base + "_" + std::to_string(n);
+      }
+      taken.insert(upper(d.setName));
+      double sumE = 0, sumNu = 0, sumRho = 0;
+      for (auto t : members)
+      {
+        const double v = volume(t);
+        d.volume += v;
+        sumE += v * e->values[t];
+        sumNu += nu ? v * nu->values[t] : 0.0;
+        sumRho += rho ? v * rho->values[t] : 0.0;
+      }
+      d.youngsModulus = sumE / d.volume;
+      d.poissonRatio = sumNu / d.volume;
+      d.density = rho ? sumRho / d.volume : std::numeric_limits<double>::quiet_NaN();
+      d.tetrahedra = std::move(members);
+      out.push_back(std::move(d));
+    }
+  }
+  return out;
+}
+
 void writeAbaqus(const TetMesh& mesh, const std::string& path, const AbaqusOptions& options)
 {
   checkWritable(mesh, path);
-  std::vector<SolidMaterial> materials;
+  std::vector<DeckMaterial> materials;
   if (options.materials)
   {
     try
     {
-      materials = solidMaterials(mesh);
+      materials = deckMaterials(mesh, options.modulusBinWidth);
     }
     catch (const std::invalid_argument& e)
     {
@@ -441,6 +533,13 @@ void writeAbaqus(const TetMesh& mesh, const std::string& path, const AbaqusOptio
           std::replace(n.begin(), n.end(), '\n', ' ');
           out.print(
             "** material %zu: ELSET %s = cell '%s'\n", m + 1, setNames[m].c_str(), n.c_str());
+          const auto bins = std::count_if(materials.begin(), materials.end(),
+            [&](const DeckMaterial& d) { return d.material == std::int32_t(m + 1) && d.bin > 0; });
+          if (bins > 0)
+          {
+            out.print("**   its moduli in %zu bins of %.6g in ln E: ELSETs %s_E<bin>\n",
+              static_cast<std::size_t>(bins), options.modulusBinWidth, setNames[m].c_str());
+          }
         }
       }
       out.print("*NODE, NSET=NALL\n");
@@ -464,6 +563,15 @@ void writeAbaqus(const TetMesh& mesh, const std::string& path, const AbaqusOptio
       }
       for (const auto& s : materials)
       {
+        if (s.bin > 0)
+        {
+          out.print("*ELSET, ELSET=%s\n", s.setName.c_str());
+          for (std::size_t i = 0; i < s.tetrahedra.size(); ++i)
+          {
+            const bool last = i + 1 == s.tetrahedra.size() || (i + 1) % 16 == 0;
+            out.print(last ? "%zu\n" : "%zu, ", s.tetrahedra[i] + 1);
+          }
+        }
         out.print("*MATERIAL, NAME=%s\n*ELASTIC\n%.12e, %.12e\n", s.setName.c_str(),
           s.youngsModulus, s.poissonRatio);
         if (std::isfinite(s.density))
