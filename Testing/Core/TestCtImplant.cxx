@@ -355,6 +355,53 @@ void checkMaterialsFromTheScan()
   EXPECT_LE(integrated.maxModulus, 6850 * std::pow(1 + 0.001 * 2986, 1.49) * 1.005);
 }
 
+/// The curves where the scan's iso-surface meets the clip box's faces are protected, and the
+/// free ends of their chains lie on the box's edges (the backend extends the tracer's short ends
+/// onto them; pieces of one chain share their end points).
+void checkScanCreasesProtected()
+{
+  const Study& s = study();
+  mesh::TetraOptions o;
+  o.size = 1;
+  o.threads = 2;
+  std::size_t onFace = 0;
+  std::map<std::array<double, 3>, int> ends;
+  for (const auto& line : mesh::cgalFeatureCurves(s.complex, o))
+  {
+    const bool face = std::all_of(
+      line.begin(), line.end(), [](const Point3& p) { return std::abs(p[1] - kLo[1]) < 1e-9; });
+    const bool iso = line.size() >= 3 &&
+      std::all_of(line.begin() + 1, line.end() - 1,
+        [&](const Point3& p) { return std::abs(trilinear(*s.grid, p) - kIso) < 1; });
+    if (face && iso && line.front() != line.back())
+    {
+      ++onFace;
+      ++ends[line.front()];
+      ++ends[line.back()];
+    }
+  }
+  std::size_t free = 0, freeOnEdges = 0;
+  for (const auto& [p, count] : ends)
+  {
+    if (count != 1)
+    {
+      continue;
+    }
+    int boundaries = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      boundaries += std::abs(p[a] - kLo[a]) < 1e-9 || std::abs(p[a] - kHi[a]) < 1e-9;
+    }
+    ++free;
+    freeOnEdges += boundaries >= 2;
+  }
+  std::cout << "creases: " << onFace << " iso-curves on the face y = " << kLo[1] << ", " << free
+            << " free ends, " << freeOnEdges << " of them on the box's edges\n";
+  EXPECT_GE(onFace, 1u);
+  EXPECT_GE(free, 2u);
+  EXPECT_EQ(freeOnEdges, free);
+}
+
 /// One test for all the numbers: the mesh is made once per process, and ctest runs every TEST in
 /// a process of its own.
 TEST(CtImplant, IssueNumbers)
@@ -378,6 +425,10 @@ TEST(CtImplant, IssueNumbers)
   {
     SCOPED_TRACE("MaterialsFromTheScan");
     checkMaterialsFromTheScan();
+  }
+  {
+    SCOPED_TRACE("ScanCreasesProtected");
+    checkScanCreasesProtected();
   }
 }
 
