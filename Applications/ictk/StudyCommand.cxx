@@ -17,14 +17,20 @@
 #include "Mesh/Writers.h"
 #include "Voxel/VolumeFile.h"
 #include "Voxel/VoxelField.h"
+#ifdef ICTK_HAVE_MESH_CGAL
+#include "Mesh/CGAL/MeshCgal.h"
+#endif
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 namespace ictk::cli
@@ -34,6 +40,10 @@ namespace
 
 using Json = nlohmann::json;
 namespace fs = std::filesystem;
+
+/// The smallest gap between protected curves a study accepts, relative to the size (the
+/// example's 0.5 mm shell at size 1 is 0.5; a 0.1 mm one, refused, is 0.1).
+constexpr double kSmallestGap = 0.25;
 
 /// The "study" object of a complex file, with the defaults of docs/medical.md.
 struct StudySettings
@@ -180,6 +190,93 @@ void checkImplants(const complex::Complex& k, const StudySettings& s)
   }
 }
 
+/// The smallest distance between two of the curves the CGAL backend protects, away from the
+/// corners they share (points within `size` of the other curve's ends are not compared).
+struct CurveGap
+{
+  double distance = std::numeric_limits<double>::infinity();
+  frep::Point3 at{};
+};
+
+CurveGap closestCurves(const std::vector<std::vector<frep::Point3>>& curves, double size)
+{
+  auto distance = [](const frep::Point3& a, const frep::Point3& b)
+  {
+    return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  };
+  auto toSegment = [&](const frep::Point3& p, const frep::Point3& a, const frep::Point3& b)
+  {
+    const frep::Point3 ab{ b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+    const double length2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    const double t = length2 > 0
+      ? std::clamp(
+          ((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1] + (p[2] - a[2]) * ab[2]) / length2, 0.0,
+          1.0)
+      : 0.0;
+    return distance(p, { a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2] });
+  };
+  CurveGap gap;
+  for (std::size_t i = 0; i < curves.size(); ++i)
+  {
+    for (std::size_t j = 0; j < curves.size(); ++j)
+    {
+      const auto& b = curves[j];
+      if (i == j || b.size() < 2)
+      {
+        continue;
+      }
+      for (const auto& p : curves[i])
+      {
+        if (distance(p, b.front()) < size || distance(p, b.back()) < size)
+        {
+          continue;
+        }
+        for (std::size_t k = 1; k < b.size(); ++k)
+        {
+          const double d = toSegment(p, b[k - 1], b[k]);
+          if (d < gap.distance)
+          {
+            gap = { d, p };
+          }
+        }
+      }
+    }
+  }
+  return gap;
+}
+
+/// The curves on an implant's boundary (every point where one of the implants' fields, the min
+/// of its inside fields, vanishes): the thin layers the study makes are between these.
+std::vector<std::vector<frep::Point3>> implantCurves(const complex::Complex& k,
+  const StudySettings& s, const std::vector<std::vector<frep::Point3>>& curves, double size)
+{
+  std::vector<std::unique_ptr<frep::FieldEvaluator>> fields;
+  for (complex::CellId id : k.cellsOfDimension(3))
+  {
+    const complex::Cell& c = k.cell(id);
+    const auto* g = std::get_if<complex::ImplicitGeometry>(&c.geometry);
+    if (g && std::find(s.implants.begin(), s.implants.end(), c.name) != s.implants.end())
+    {
+      fields.push_back(frep::minField(g->inside)->evaluator());
+    }
+  }
+  std::vector<std::vector<frep::Point3>> out;
+  for (const auto& line : curves)
+  {
+    const bool onImplant = std::all_of(line.begin(), line.end(),
+      [&](const frep::Point3& p)
+      {
+        return std::any_of(fields.begin(), fields.end(),
+          [&](const auto& f) { return std::abs(f->value(p)) < 1e-4 * size; });
+      });
+    if (onImplant)
+    {
+      out.push_back(line);
+    }
+  }
+  return out;
+}
+
 struct StudyOptions
 {
   std::string Model;
@@ -261,9 +358,31 @@ int StudyCommand::run()
     throw UserError(std::string("study: the scan's Hounsfield units: ") + e.what());
   }
   const double readSeconds = Seconds(t0);
+  // CGAL 5.5 cannot resolve two protected curves closer than about its protecting balls (the
+  // size): issue 15 met runs that never finish, and here a 0.1 mm shell at size 1 came out with
+  // 8 % of its volume. Refuse such a study rather than write a wrong mesh.
+  const double size = o.Size > 0 ? o.Size : settings.size;
+  CheckSize(size);
+#ifdef ICTK_HAVE_MESH_CGAL
+  {
+    mesh::TetraOptions trace;
+    trace.size = size;
+    trace.threads = o.Threads;
+    const CurveGap gap =
+      closestCurves(implantCurves(k, settings, mesh::cgalFeatureCurves(k, trace), size), size);
+    if (gap.distance < kSmallestGap * size)
+    {
+      std::ostringstream m;
+      m << "study: the implants' protected curves come " << gap.distance << " apart near ("
+        << gap.at[0] << ", " << gap.at[1] << ", " << gap.at[2] << "), under " << kSmallestGap
+        << " of the size " << size << ": the CGAL backend would lose the layer between them or "
+        << "not finish; use --size " << gap.distance / kSmallestGap << " or less";
+      throw UserError(m.str());
+    }
+  }
+#endif
   mesh::TetraOptions options;
-  options.size = o.Size > 0 ? o.Size : settings.size;
-  CheckSize(options.size);
+  options.size = size;
   options.deterministic = o.Deterministic;
   options.threads = o.Threads;
   ProgressBar bar("study", false, !o.Json);
