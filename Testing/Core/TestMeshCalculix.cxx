@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <random>
 #include <set>
 #include <sstream>
@@ -391,6 +392,31 @@ TEST(CalculixFrd, ReadsTheShortFormat)
   EXPECT_TRUE(std::isnan(r.displacement[0][0])); // node 1 left out of the block
 }
 
+TEST(CalculixFrd, ReadsContinuationRecords)
+{
+  // More than six components: a node's values go on over ' -2' records whose number columns
+  // are blank (5 in format 0).
+  std::string text = "    2C                             1                                     0\n"
+                     " -1    1 0.00000E+00 0.00000E+00 0.00000E+00\n"
+                     " -3\n"
+                     "  100CL  101 2.000000000           1                     0    1           0\n"
+                     " -4  MANY        8    1\n";
+  for (int c = 1; c <= 8; ++c)
+  {
+    text += " -5  C" + std::to_string(c) + "          1    1    0    0\n";
+  }
+  text += " -1    1 1.00000E+00 2.00000E+00 3.00000E+00 4.00000E+00 5.00000E+00 6.00000E+00\n"
+          " -2      7.00000E+00-8.00000E+00\n"
+          " -3\n"
+          " 9999\n";
+  Scratch s("frd8");
+  const auto r = mesh::readFrd(writeText(s, "many.frd", text));
+  const mesh::FrdBlock& b = r.blocks.at("MANY");
+  EXPECT_EQ(b.time, 2.0);
+  ASSERT_EQ(b.components.size(), 8u);
+  EXPECT_EQ(b.values, (std::vector<double>{ 1, 2, 3, 4, 5, 6, 7, -8 }));
+}
+
 TEST(CalculixFrd, ErrorsNameFileAndLine)
 {
   Scratch s("frdbad");
@@ -482,6 +508,74 @@ TEST(CalculixRun, Cancels)
 
 namespace
 {
+/// An element's E as a written .inp gives it, read independently of the writer: *ELEMENT and
+/// *ELSET sets, *MATERIAL / *ELASTIC, *SOLID SECTION (element id -> E; an element given two
+/// sections is NaN).
+std::map<std::size_t, double> deckModuli(const std::string& path)
+{
+  std::map<std::string, std::vector<std::size_t>> sets;
+  std::map<std::string, double> modulus;
+  std::vector<std::pair<std::string, std::string>> sections; // (elset, material)
+  std::ifstream in(path);
+  std::string line, keyword, set, material;
+  auto parameter = [](const std::string& l, const std::string& name)
+  {
+    const auto at = l.find(name + "=");
+    return at == std::string::npos
+      ? std::string()
+      : l.substr(at + name.size() + 1, l.find(',', at) - at - name.size() - 1);
+  };
+  while (std::getline(in, line))
+  {
+    if (line.rfind("**", 0) == 0)
+    {
+      continue;
+    }
+    if (line[0] == '*')
+    {
+      keyword = line.substr(0, line.find(','));
+      set = parameter(line, "ELSET");
+      if (keyword == "*MATERIAL")
+      {
+        material = parameter(line, "NAME");
+      }
+      if (keyword == "*SOLID SECTION")
+      {
+        sections.emplace_back(set, parameter(line, "MATERIAL"));
+      }
+      continue;
+    }
+    std::istringstream fields(line);
+    std::string field;
+    if (keyword == "*ELASTIC")
+    {
+      std::getline(fields, field, ',');
+      modulus[material] = std::stod(field);
+    }
+    else if (keyword == "*ELEMENT")
+    {
+      std::getline(fields, field, ',');
+      sets[set].push_back(std::stoul(field));
+    }
+    else if (keyword == "*ELSET")
+    {
+      while (std::getline(fields, field, ','))
+      {
+        sets[set].push_back(std::stoul(field));
+      }
+    }
+  }
+  std::map<std::size_t, double> e;
+  for (const auto& [elset, name] : sections)
+  {
+    for (const std::size_t id : sets.at(elset))
+    {
+      e[id] = e.count(id) ? std::nan("") : modulus.at(name);
+    }
+  }
+  return e;
+}
+
 mesh::CompressionResult compress(const mesh::TetMesh& m, const Scratch& s, double d)
 {
   mesh::CompressionOptions o;
@@ -517,6 +611,13 @@ TEST(CalculixCompression, HomogeneousBoxIsVoigt)
   const mesh::FrdResults frd = mesh::readFrd(r.run.frd);
   const mesh::PointResults p = mesh::resultsOnMesh(m, frd);
   ASSERT_EQ(p.displacement.size(), m.points.size());
+  ASSERT_EQ(frd.elements.size(), m.tetrahedra.size());
+  for (const mesh::FrdElement& element : frd.elements)
+  {
+    ASSERT_EQ(element.type, 3);
+    const auto& k = m.tetrahedra[element.id - 1];
+    EXPECT_EQ(element.nodes, (std::vector<std::size_t>{ k[0] + 1, k[1] + 1, k[2] + 1, k[3] + 1 }));
+  }
   const auto& anchor = m.points[c.anchorNode - 1];
   double worstU = 0, worstS = 0;
   for (std::size_t i = 0; i < m.points.size(); ++i)
@@ -605,6 +706,24 @@ TEST(CalculixCompression, RandomModulusLiesBetweenTheBounds)
   EXPECT_GT(c.materials.size(), 300u);
   EXPECT_LE(c.reussModulus, r.apparentModulus);
   EXPECT_LE(r.apparentModulus, c.voigtModulus);
+  // The bounds are those of the deck as written: every element in one solid section, its E
+  // within one bin width of its own.
+  const auto written = deckModuli(s / "compression.inp");
+  ASSERT_EQ(written.size(), m.tetrahedra.size());
+  const auto& e = mesh::findArray(m, "youngs_modulus")->values;
+  double volume = 0, stiffness = 0, compliance = 0, worst = 0;
+  for (const auto& [id, modulus] : written)
+  {
+    ASSERT_FALSE(std::isnan(modulus)) << "element " << id << " has two sections";
+    const double v = volumeOf(m, id - 1);
+    volume += v;
+    stiffness += v * modulus;
+    compliance += v / modulus;
+    worst = std::max(worst, std::abs(std::log(modulus / e[id - 1])));
+  }
+  EXPECT_LT(worst, 0.01);
+  EXPECT_NEAR(c.voigtModulus / (stiffness / volume), 1, 1e-11);
+  EXPECT_NEAR(c.reussModulus / (volume / compliance), 1, 1e-11);
   std::printf("random box: %zu tetrahedra, %zu materials, Reuss %.2f <= E_app %.2f <= Voigt "
               "%.2f (E_app / Voigt %.4f, / Reuss %.4f), ccx %.3f s\n",
     m.tetrahedra.size(), c.materials.size(), c.reussModulus, r.apparentModulus, c.voigtModulus,
@@ -623,4 +742,20 @@ TEST(CalculixCompression, RefusesWhatIsNoCompressionCase)
   const auto c = mesh::compressionCase(m, o, nullptr);
   EXPECT_EQ(c.bottomNodes.size(), 4u);
   EXPECT_NE(c.anchorNode, c.rollerNode);
+  // No modulus: the cell is named, and the folder solveCompression would have made is not left.
+  mesh::TetMesh bare = m;
+  bare.cellData.clear();
+  Scratch s("refused");
+  try
+  {
+    mesh::solveCompression(bare, s / "work", o, ccx());
+    FAIL() << "no error";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_THAT(e.what(),
+      HasSubstr("cell 'specimen') is a solver-unfriendly material: no "
+                "youngs_modulus attribute"));
+  }
+  EXPECT_FALSE(fs::exists(s / "work"));
 }

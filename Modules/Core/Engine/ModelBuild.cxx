@@ -108,6 +108,55 @@ void ModelState::build()
   if (!any)
     fail({ 1, 1 }, "the model has no IC instance (only templates)");
   buildStepper();
+  // The blend-like shapes' numbers at the start; refused here, at their place, when wrong.
+  for (CellSpec& c : cells)
+    if (c.operands)
+    {
+      const OperandNumbers n = evaluateOperands(c, kNone);
+      c.operands->amount = n.amount;
+      c.operands->spaceTime = n.spaceTime;
+    }
+}
+
+OperandNumbers ModelState::evaluateOperands(const CellSpec& c, std::size_t instance)
+{
+  OperandNumbers out;
+  const CellSpec::Operands& o = *c.operands;
+  const bool spaceTimeBlend = o.kind == ShapePart::Kind::SpaceTimeBlend;
+  double* slots[] = { &out.spaceTime.t0, &out.spaceTime.t1, &out.spaceTime.a0, &out.spaceTime.a1,
+    &out.spaceTime.a2, &out.spaceTime.a3 };
+  EngineScope scope(*this, c.name, instance);
+  for (std::size_t i = 0; i < o.numbers.size(); ++i)
+  {
+    const Expr& e = *o.numbers[i];
+    const Value v = interpreter.evaluate(e, scope);
+    if (!v.isNumber() || !std::isfinite(v.number))
+      fail(e.pos,
+        "argument " + std::to_string(i + 3) + " of the shape of " + c.name +
+          " must be a finite number");
+    if (spaceTimeBlend && i < 6)
+      *slots[i] = v.number;
+    else if (!spaceTimeBlend && i == 0)
+    {
+      if (v.number < 0)
+        fail(e.pos,
+          "the blend amount of " + c.name + " must not be negative, it is " +
+            std::to_string(v.number));
+      out.amount = v.number;
+    }
+  }
+  if (spaceTimeBlend)
+  {
+    try
+    {
+      frep::validateSpaceTimeBlend("spaceTimeBlendCells", out.spaceTime);
+    }
+    catch (const std::exception& e)
+    {
+      fail(o.pos, std::string("the shape of ") + c.name + ": " + e.what());
+    }
+  }
+  return out;
 }
 
 void ModelState::checkSpaceTimeBlends() const
@@ -789,6 +838,10 @@ void ModelState::buildStepper()
     r.updatePost = [this, n](dyn::StepContext& ctx)
     {
       runCell(n, "updatePost", ctx);
+      // A blend's numbers follow the parameters its update changed.
+      const CellSpec& spec = cells[cellIndex.at(n)];
+      if (spec.operands)
+        s.operandNumbers[n] = evaluateOperands(spec, s.active);
     };
     r.init = [this, n](dyn::StepContext& ctx)
     {

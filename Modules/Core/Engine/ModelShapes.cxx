@@ -176,8 +176,15 @@ void operandsShape(const ShapeCall& s)
   const std::vector<Value>& args = s.args;
   if (args.size() < 2 || args[0].type != Value::Type::Cell || args[1].type != Value::Type::Cell)
     s.fail(s.name + " takes two cells");
-  s.c.operands = CellSpec::Operands{ kind, args[0].text, args[1].text,
-    kind == ShapePart::Kind::Blend ? s.size(2) : 0.0, {}, s.expr.pos };
+  CellSpec::Operands o;
+  o.kind = kind;
+  o.a = args[0].text;
+  o.b = args[1].text;
+  o.pos = s.expr.pos;
+  // The numbers are evaluated at every step (ModelState::evaluateOperands).
+  for (std::size_t i = 3; i < s.expr.kids.size(); ++i)
+    o.numbers.push_back(s.expr.kids[i].get());
+  s.c.operands = std::move(o);
 }
 
 /// spaceTimeBlendCells(A, B, t0, t1, a0, a1, a2, a3): a space-time cell (thesis 5.3.1) whose
@@ -185,18 +192,6 @@ void operandsShape(const ShapeCall& s)
 void spaceTimeBlendShape(const ShapeCall& s)
 {
   operandsShape<ShapePart::Kind::SpaceTimeBlend>(s);
-  frep::SpaceTimeBlendParameters& p = s.c.operands->spaceTime;
-  double* slots[] = { &p.t0, &p.t1, &p.a0, &p.a1, &p.a2, &p.a3 };
-  for (std::size_t i = 0; i < 6; ++i)
-    *slots[i] = s.num(i + 2);
-  try
-  {
-    frep::validateSpaceTimeBlend(s.name.c_str(), p);
-  }
-  catch (const std::exception& e)
-  {
-    s.fail(e.what());
-  }
   s.c.spaceTime = true;
 }
 
@@ -251,7 +246,8 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
       fail(v->pos, "a shape is hyperfun { ... }, file(\"...\") or a constructor such as disk(r)");
     const std::string& f = v->text;
     const lang::icm::ShapeBuiltin* shape = lang::icm::findShapeBuiltin(f);
-    // The leading arguments that name cells are passed on as cells (blend, union).
+    // The leading arguments that name cells are passed on as cells (blend, union); the numbers
+    // after them are evaluated at every step, in the cell's scope (evaluateOperands).
     const std::size_t cellArguments = shape ? static_cast<std::size_t>(shape->cellArguments) : 0;
     std::vector<Value> args;
     for (std::size_t i = 1; i < v->kids.size(); ++i)
@@ -259,7 +255,7 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
       const Expr& a = *v->kids[i];
       if (i <= cellArguments && a.kind == Expr::Kind::Name)
         args.push_back(Value::cell(a.text));
-      else
+      else if (cellArguments == 0)
         args.push_back(interpreter.evaluate(a, scope));
     }
     ShapeConstructor build = nullptr;

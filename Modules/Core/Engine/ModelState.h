@@ -86,6 +86,10 @@ struct CellSpec
   {
     ShapePart::Kind kind = ShapePart::Kind::Union;
     std::string a, b;
+    /// The constructor's numbers (blend: amount; space-time blend: t0, t1, a0, a1, a2, a3),
+    /// expressions over the cell's and the model's parameters evaluated at every step.
+    std::vector<const Expr*> numbers;
+    /// Their values at the model's start (ModelState::evaluateOperands).
     double amount = 0.0;
     frep::SpaceTimeBlendParameters spaceTime; ///< SpaceTimeBlend only
     Pos pos;                                  ///< the constructor's call
@@ -132,6 +136,13 @@ struct InstanceSpec
   std::vector<std::pair<std::string, std::string>> attributeLinks; ///< (cell, attribute)
 };
 
+/// The numbers of a blend-like shape at one step (CellSpec::Operands).
+struct OperandNumbers
+{
+  double amount = 0.0;
+  frep::SpaceTimeBlendParameters spaceTime;
+};
+
 /// The structural state: what the parameter table cannot hold. Copied with every snapshot.
 struct Structure
 {
@@ -143,7 +154,8 @@ struct Structure
   std::map<std::string, std::shared_ptr<const std::vector<ShapePart>>> shapes; ///< set by code
   std::map<std::string, std::vector<double>> shapeParameters;
   std::map<std::string, std::uint64_t> versions;
-  std::map<std::string, Value> texts; ///< non-numeric parameters (strings)
+  std::map<std::string, OperandNumbers> operandNumbers; ///< evaluated at each step
+  std::map<std::string, Value> texts;                   ///< non-numeric parameters (strings)
 };
 
 struct ModelState
@@ -195,6 +207,17 @@ struct ModelState
   void buildTimespans();
   /// Every spaceTimeBlendCells cell is one dimension above its two operands.
   void checkSpaceTimeBlends() const;
+  /// The numbers of cell c's blend-like shape evaluated in its scope within `instance` (kNone:
+  /// the model's start); fails at the place of one that is not a number or out of range.
+  OperandNumbers evaluateOperands(const CellSpec& c, std::size_t instance);
+  /// The numbers of cell c's blend-like shape at the current step.
+  OperandNumbers operandNumbersOf(const CellSpec& c) const
+  {
+    const auto it = s.operandNumbers.find(c.name);
+    return it != s.operandNumbers.end()
+      ? it->second
+      : OperandNumbers{ c.operands->amount, c.operands->spaceTime };
+  }
   void buildAnimations();
   void buildEvents();
   void buildCell(const CellDef& def);

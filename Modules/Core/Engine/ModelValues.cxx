@@ -174,12 +174,13 @@ PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
   {
     ShapePart part;
     PlacedShapePtr a = shapeOf(c.operands->a, depth + 1), b = shapeOf(c.operands->b, depth + 1);
+    const OperandNumbers n = operandNumbersOf(c);
     if (c.operands->kind == ShapePart::Kind::SpaceTimeBlend)
-      part = geometry::spaceTimeBlendPart(a, b, c.operands->spaceTime, shapeTime());
+      part = geometry::spaceTimeBlendPart(a, b, n.spaceTime, shapeTime());
     part.kind = c.operands->kind;
     part.operandA = a;
     part.operandB = b;
-    part.amount = c.operands->amount;
+    part.amount = n.amount;
     part.bounds = c.domain;
     shape->parts.push_back(part);
     return shape;
@@ -199,7 +200,12 @@ std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
     v = mix(v, bitsOf(shapeTime()));
   if (!c.operands || s.shapes.count(cell) || depth > static_cast<int>(cells.size()))
     return v;
-  // A blend or union lives in world coordinates: it changes when an operand moves.
+  // A blend or union lives in world coordinates: it changes when an operand moves, and when its
+  // numbers change.
+  const OperandNumbers n = operandNumbersOf(c);
+  for (double d : { n.amount, n.spaceTime.t0, n.spaceTime.t1, n.spaceTime.a0, n.spaceTime.a1,
+         n.spaceTime.a2, n.spaceTime.a3 })
+    v = mix(v, bitsOf(d));
   for (const std::string& o : { c.operands->a, c.operands->b })
   {
     v = mix(v, versionOf(o, depth + 1));

@@ -140,7 +140,8 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
       "centred on the origin" },
     { Id::Sphere, { "sphere", 1, 1, "sphere(real radius)", "shape" }, 0, "centred on the origin" },
     { Id::Blend, { "blend", 3, 3, "blend(cellA, cellB, real amount)", "shape" }, 2,
-      "the blended union of two cells' shapes" },
+      "the blended union of two cells' shapes; `amount` (>= 0) may read the cell's and the "
+      "model's parameters: it is evaluated at every step" },
     { Id::Union, { "union", 2, 2, "union(cellA, cellB)", "shape" }, 2,
       "the union of two cells' shapes" },
     { Id::SpaceTimeBlend,

@@ -118,14 +118,15 @@ void Checker::cell(const CellDef& c, const CellMap& cells, const Instance* in)
     {
       err(p.pos, "property '" + p.name + "' given twice");
     }
-    property(p, cells);
+    property(p, cells, &c, in);
   }
   std::map<std::string, const ParamDecl*> ps;
   params(c.parameters, ps, &cells, "parameter");
   reactionsOf(c.reactions, cells, in, &c);
 }
 
-void Checker::property(const Property& p, const CellMap& cells)
+void Checker::property(
+  const Property& p, const CellMap& cells, const CellDef* owner, const Instance* in)
 {
   const auto single = [&](Expr::Kind kind, const char* what)
   {
@@ -221,7 +222,7 @@ void Checker::property(const Property& p, const CellMap& cells)
     }
     for (const ExprPtr& v : p.values)
     {
-      shape(v, cells);
+      shape(v, cells, owner, in);
     }
   }
   else if (p.name == "mapping" && p.isHyperFun)
@@ -280,7 +281,8 @@ void Checker::hyperFun(const Property& p)
   }
 }
 
-void Checker::shape(const ExprPtr& v, const CellMap& cells)
+void Checker::shape(
+  const ExprPtr& v, const CellMap& cells, const CellDef* owner, const Instance* in)
 {
   if (v->kind != Expr::Kind::Call || v->text.empty())
   {
@@ -346,9 +348,31 @@ void Checker::shape(const ExprPtr& v, const CellMap& cells)
         a->kind == Expr::Kind::Name ? "undefined cell '" + a->text + "'" : "expected a cell name");
     }
   }
+  // The numbers of a shape made of cells (a blend's amount, a space-time blend's parameters) are
+  // evaluated every step: they may read the cell's parameters and the model's. Other shapes are
+  // built once, from constants.
   for (std::size_t i = cellArguments + 1; i < v->kids.size(); ++i)
   {
-    constant(v->kids[i]);
+    if (cellArguments == 0 || !owner)
+    {
+      constant(v->kids[i]);
+      continue;
+    }
+    Code code;
+    code.instance = in;
+    code.cells = &cells;
+    code.cell = owner;
+    code.vars = in ? instanceVars_ : globalVars_;
+    for (const std::string& name : paramsOf(owner))
+    {
+      code.vars.insert(name);
+    }
+    const Ty t = expr(v->kids[i], code);
+    if (t != Ty::Unknown && !numeric(t))
+    {
+      err(v->kids[i]->pos,
+        "argument " + std::to_string(i) + " of '" + v->text + "' must be a number");
+    }
   }
 }
 

@@ -143,10 +143,14 @@ private:
   /// `Cell.member...`: the first member must be a parameter or a property of the cell.
   void cellMember(const Expr& path, const CellMap& cells);
   void cell(const CellDef& c, const CellMap& cells, const Instance* in);
-  void property(const Property& p, const CellMap& cells);
+  /// `owner` and `in`: the cell the property belongs to and its instance, when known (the
+  /// numbers of blend-like shapes may then read the cell's parameters).
+  void property(const Property& p, const CellMap& cells, const CellDef* owner = nullptr,
+    const Instance* in = nullptr);
   // Compiles an inline HyperFun shape; its errors are placed in the model text.
   void hyperFun(const Property& p);
-  void shape(const ExprPtr& v, const CellMap& cells);
+  void shape(const ExprPtr& v, const CellMap& cells, const CellDef* owner = nullptr,
+    const Instance* in = nullptr);
   /// Whether the named cell's shape is a mesh file (file("*.obj" or "*.off")): an explicit surface
   /// that the geometric queries, blends and unions do not take.
   bool isMeshCell(const std::string& name, const CellMap* cells, int depth = 0) const;

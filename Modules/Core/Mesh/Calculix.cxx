@@ -475,6 +475,7 @@ CompressionResult solveCompression(const TetMesh& mesh, const std::string& folde
   const CompressionOptions& options, const CalculixOptions& calculix, const std::string& job)
 {
   std::error_code ec;
+  const bool fresh = !fs::exists(folder, ec);
   fs::create_directories(folder, ec);
   if (ec)
   {
@@ -482,7 +483,19 @@ CompressionResult solveCompression(const TetMesh& mesh, const std::string& folde
   }
   CompressionResult r;
   const std::string deck = (fs::path(folder) / (job + ".inp")).string();
-  r.compression = writeCompressionDeck(mesh, deck, options);
+  try
+  {
+    r.compression = writeCompressionDeck(mesh, deck, options);
+  }
+  catch (...)
+  {
+    // A mesh that makes no deck leaves no folder behind.
+    if (fresh)
+    {
+      fs::remove_all(folder, ec);
+    }
+    throw;
+  }
   r.run = runCalculix(deck, calculix);
   const auto totals = readDatTotalForces(r.run.dat);
   const auto top = totals.find(topPlatenSet), bottom = totals.find(bottomPlatenSet);

@@ -299,7 +299,11 @@ void readResults(Reader& r, FrdResults& out)
     {
       r.fail("expected a result record ' -1', its continuation ' -2' or the block's end ' -3'");
     }
-    for (; at + 12 <= r.line().size() + 0 && filled < n; at += 12)
+    else
+    {
+      at += width; // a continuation leaves the node number's columns blank
+    }
+    for (; at + 12 <= r.line().size() && filled < n; at += 12)
     {
       block.values[node * n + filled++] = r.real(at, 12, "a value");
     }

@@ -5,7 +5,8 @@
 // kept by name), the last increment of each. The format is fixed-width (values touch: "-1.0E+00
 // -2.0E+00" is written "-1.00000E+00-2.00000E+00"), so lines are cut by column, not by spaces:
 // a key of 3 characters, a node or element number of 5 (format 0) or 10 (format 1) characters,
-// then values of 12. Errors name the file and the line.
+// then values of 12, six a record (a node's further values continue on ' -2' records whose
+// number columns are blank). Errors name the file and the line.
 
 #include "Mesh/TetMesh.h"
 
