@@ -54,6 +54,7 @@ std::unique_ptr<Command> benchCommand();    // BenchCommand.cxx
 std::unique_ptr<Command> meshCommand();     // MeshCommand.cxx
 std::unique_ptr<Command> renderCommand();   // RenderCommand.cxx
 std::unique_ptr<Command> tetraCommand();    // TetraCommand.cxx
+std::unique_ptr<Command> studyCommand();    // StudyCommand.cxx
 std::unique_ptr<Command> solveCommand();    // SolveCommand.cxx
 std::unique_ptr<Command> runCommand();      // RunCommand.cxx
 std::unique_ptr<Command> infoCommand();     // InfoCommand.cxx

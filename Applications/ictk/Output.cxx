@@ -3,6 +3,8 @@
 
 #include "Command.h"
 
+#include "ictkTetrahedralize.h"
+
 #include <vtkDataObject.h>
 #include <vtkNew.h>
 #include <vtkUnstructuredGrid.h>
@@ -132,6 +134,14 @@ void WriteUnstructuredGrid(
     throw UserError("cannot write '" + destination + "'");
   }
   file.Commit();
+}
+
+void WriteTetMeshVtu(const mesh::TetMesh& m, const std::string& path)
+{
+  vtkNew<vtkUnstructuredGrid> grid;
+  ictkTetrahedralize::Convert(m, grid);
+  AtomicOutput file(path);
+  WriteUnstructuredGrid(grid, file, path);
 }
 
 } // namespace ictk::cli

@@ -10,6 +10,11 @@ class vtkDataObject;
 class vtkUnstructuredGrid;
 class vtkXMLWriterBase;
 
+namespace ictk::mesh
+{
+struct TetMesh;
+}
+
 namespace ictk::cli
 {
 
@@ -42,5 +47,9 @@ void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::st
 /// `destination` when the writer fails.
 void WriteUnstructuredGrid(
   vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination);
+
+/// A tetrahedral mesh as a .vtu (ictkTetrahedralize's form: MaterialId, CellId and the
+/// per-tetrahedron arrays), through a temporary file renamed on success.
+void WriteTetMeshVtu(const mesh::TetMesh& mesh, const std::string& path);
 
 } // namespace ictk::cli

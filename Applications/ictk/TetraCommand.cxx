@@ -14,10 +14,6 @@
 #include "Mesh/TetAttributes.h"
 #include "Mesh/Validity.h"
 #include "Mesh/Writers.h"
-#include "ictkTetrahedralize.h"
-
-#include <vtkNew.h>
-#include <vtkUnstructuredGrid.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -32,15 +28,6 @@ namespace ictk::cli
 {
 namespace
 {
-
-/// .vtu through VTK's writer, into a temporary file renamed on success.
-void WriteVtu(const mesh::TetMesh& m, const std::string& path)
-{
-  vtkNew<vtkUnstructuredGrid> grid;
-  ictkTetrahedralize::Convert(m, grid);
-  AtomicOutput file(path);
-  WriteUnstructuredGrid(grid, file, path);
-}
 
 struct TetraOptions
 {
@@ -144,7 +131,7 @@ int TetraCommand::run()
   const double meshSeconds = Seconds(t0);
   if (HasExtension(o.Output, ".vtu"))
   {
-    WriteVtu(m, o.Output);
+    WriteTetMeshVtu(m, o.Output);
   }
   else if (HasExtension(o.Output, ".msh"))
   {

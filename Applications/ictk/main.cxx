@@ -5,7 +5,7 @@
 // bar, Ctrl-C, timing), VtkMessages (VTK's errors as one line) and GridSampling (sample, mesh).
 //
 //   ictk models | eval | sample | mesh | convert      models and model files
-//   ictk info | validate | mesh | tetra                complexes
+//   ictk info | validate | mesh | tetra | study        complexes
 //   ictk render MODEL -o picture.png                   a picture, ray-cast
 //   ictk run MODEL.icm --frames T0:T1:DT -o out.pvd    a dynamic complex, one .vtpc per frame
 //   ictk bench                                         the performance workloads
@@ -49,6 +49,7 @@ int Run(int argc, char** argv)
   commands.push_back(meshCommand());
   commands.push_back(renderCommand());
   commands.push_back(tetraCommand());
+  commands.push_back(studyCommand());
   commands.push_back(solveCommand());
   commands.push_back(runCommand());
   commands.push_back(infoCommand());

@@ -5,6 +5,7 @@
 #include "FRep/Expr.h"
 #include "FRep/Field.h"
 #include "FRep/Tape.h"
+#include "TempDir.h"
 #include "Voxel/VdbIO.h"
 #include "Voxel/VoxelField.h"
 #include "Voxel/VoxelGrid.h"
@@ -34,28 +35,7 @@ namespace
 
 namespace fs = std::filesystem;
 
-/// A fresh folder under the system's temporary folder, removed at the end of the test.
-class TempDir
-{
-public:
-  TempDir()
-  {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() /
-      ("ictk-voxel-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir()
-  {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-
-private:
-  fs::path path_;
-};
+using ictk::test_support::TempDir;
 
 /// The 2x2x2 grid of the hand computations: corners v[i + 2j + 4k].
 std::shared_ptr<VoxelGrid> cube()

@@ -7,6 +7,7 @@ Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   | bench-scaling | render
   run-disk DATA | run-errors DATA   (ictk run on the .icm models in DATA/Models/icm)
   tetra-bar DATA | solve-bar DATA   (ictk tetra and ictk solve on DATA/Models/bar)
+  study DATA   (ictk study on DATA/Studies/ct-implant and its bad inputs; needs invesalius-examples)
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
 "@WORK@" in ICTK-ARGS is replaced by the work folder.
 """
@@ -859,6 +860,94 @@ def check_run_errors(ictk, work, data):
         sys.exit(f"FAIL: files left behind: {sorted(os.listdir(work))}")
 
 
+CRANIUM = "/usr/share/doc/invesalius-examples/examples/Cranium.inv3"
+
+
+def check_study(ictk, work, data):
+    """ictk study (issue 15): the CT-implant study writes a labelled .vtu with the material arrays
+    and an .inp; a missing, truncated or wrongly sized scan and an implant outside the specimen
+    are refused with one error line naming the problem and nothing written."""
+    import gzip
+    import io
+    import tarfile
+    if not os.path.exists(CRANIUM):
+        sys.exit(f"FAIL: {CRANIUM} is missing: install invesalius-examples (Scripts/setup does)")
+    model = os.path.join(data, "Studies", "ct-implant", "ct-implant.json")
+    vtu = os.path.join(work, "ct.vtu")
+    report = json.loads(run(ictk, ["study", model, "-o", vtu, "--deterministic", "--json"]).stdout)
+    if not os.path.exists(os.path.join(work, "ct.inp")):
+        sys.exit("FAIL: no ct.inp beside ct.vtu")
+    no_leftovers(work)
+    import vtk
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(vtu)
+    r.Update()
+    grid = r.GetOutput()
+    if grid.GetNumberOfCells() != report["tetrahedra"] or report["tetrahedra"] < 10000:
+        sys.exit(f"FAIL: {grid.GetNumberOfCells()} tetrahedra in the .vtu, {report['tetrahedra']} reported")
+    for name in ("label", "density", "youngs_modulus", "poisson_ratio"):
+        if not grid.GetCellData().GetArray(name):
+            sys.exit(f"FAIL: the .vtu has no cell array {name!r}")
+    labels = grid.GetCellData().GetArray("label")
+    modulus = grid.GetCellData().GetArray("youngs_modulus")
+    for c in range(0, grid.GetNumberOfCells(), 101):
+        if labels.GetTuple1(c) == 4 and modulus.GetTuple1(c) != 110000:
+            sys.exit(f"FAIL: implant tetrahedron {c} has modulus {modulus.GetTuple1(c)}")
+    if report["deck_materials"] < 10:
+        sys.exit(f"FAIL: only {report['deck_materials']} deck materials from the scan's moduli")
+
+    study = json.load(open(model))
+
+    def refused(name, pattern, scan=None, implant_z0=None, shell_radius=None):
+        doc = json.loads(json.dumps(study))
+        for cell in doc["cells"]:
+            if cell["name"] == "shell" and shell_radius is not None:
+                cell["inside"][0] = cell["inside"][0].replace("3.0 - ", f"{shell_radius} - ")
+            if cell["name"] == "bone" and scan is not None:
+                cell["file"] = scan
+            if cell["name"] == "implant" and implant_z0 is not None:
+                cell["bounds"][0][2] = implant_z0
+        folder = os.path.join(work, name)
+        os.makedirs(folder)
+        path = os.path.join(folder, "study.json")
+        json.dump(doc, open(path, "w"), indent=2)
+        p = run(ictk, ["study", path, "-o", os.path.join(folder, "x.vtu")], check=False)
+        # A scan the complex file cannot read is the file's diagnostic (file:line:col: error:
+        # with the line and a caret); the study's own checks are one "ictk: error:" line.
+        first = p.stderr.splitlines()[0] if p.stderr else ""
+        if p.returncode != 2 or not re.search(pattern, first) or "error: " not in first:
+            sys.exit(f"FAIL: {name}: exit {p.returncode}, stderr:\n{p.stderr}")
+        written = [f for f in os.listdir(folder) if f.startswith("x.")]
+        if written:
+            sys.exit(f"FAIL: {name}: output written despite the error: {written}")
+        no_leftovers(folder)
+
+    refused("missing", r"missing\.inv3': no such file", scan=os.path.join(work, "missing.inv3"))
+    cut = os.path.join(work, "cut.inv3")
+    with open(CRANIUM, "rb") as f, open(cut, "wb") as out:
+        out.write(f.read(4 << 20))
+    refused("truncated", r"cut\.inv3': the gzip data is truncated", scan=cut)
+    # A project whose header says 256 x 256 x 108 but whose matrix holds one slice less.
+    plist = (b'<?xml version="1.0"?><plist version="1.0"><dict><key>matrix</key><dict>'
+             b'<key>dtype</key><string>int16</string><key>filename</key><string>matrix.dat</string>'
+             b'<key>shape</key><array><integer>108</integer><integer>256</integer><integer>256</integer>'
+             b'</array></dict><key>spacing</key><array><real>0.957</real><real>0.957</real><real>1.5</real>'
+             b'</array></dict></plist>')
+    short = os.path.join(work, "short.inv3")
+    with tarfile.open(short, "w:gz") as t:
+        for member, payload in (("p/main.plist", plist), ("p/matrix.dat", bytes(256 * 256 * 107 * 2))):
+            info = tarfile.TarInfo(member)
+            info.size = len(payload)
+            t.addfile(info, io.BytesIO(payload))
+    refused("short", r"'matrix\.dat' holds 14024704 bytes; its shape 108 x 256 x 256 of int16 needs 14155776",
+            scan=short)
+    refused("outside", r"implant 'implant' reaches outside the specimen on axis z: \[140, 152\.25\]",
+            implant_z0=140)
+    # A 0.1 mm shell at size 1: CGAL would lose it (or never finish); refused before meshing.
+    refused("thin", r"the implants' protected curves come 0\.0\d+ apart .* use --size 0\.3\d+ or less",
+            shell_radius=2.6)
+
+
 def main():
     # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
     argv = sys.argv[1:]
@@ -881,6 +970,10 @@ def main():
         "run-space-time": check_run_space_time,
         "render": check_render,
     }
+    if check == "study":
+        check_study(ictk, work, rest[0])
+        print("OK")
+        return
     if check == "tetra-bar":
         check_tetra_bar(ictk, work, rest[0])
         print("OK")

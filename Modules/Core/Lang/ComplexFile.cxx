@@ -3,7 +3,7 @@
 
 #include "FRep/Tape.h"
 #include "Lang/HyperFun.h"
-#include "Voxel/VdbIO.h"
+#include "Voxel/VolumeFile.h"
 #include "Voxel/VoxelField.h"
 
 #include <nlohmann/json.hpp>
@@ -505,12 +505,13 @@ private:
   }
 
   /// A V cell: the solid where a sampled scalar field is above (or below) an iso-value, read by
-  /// trilinear interpolation.
+  /// trilinear interpolation, optionally clipped to a box or an FRep region (docs/complex-json.md).
   void readVoxel(const Json& spec, Cell& c, const std::string& where)
   {
     if (!spec.contains("file") || !spec["file"].is_string())
     {
-      report(where + ": a voxel cell needs \"file\" (.vdb, or a VTK image through ictk)", current_);
+      report(where + ": a voxel cell needs \"file\" (.vdb, .inv3, or a VTK image through ictk)",
+        current_);
       return;
     }
     if (c.dimension != 3)
@@ -527,34 +528,109 @@ private:
       return;
     }
     const double iso = number(spec, "iso", 0.0, where + ": \"iso\"");
+    complex::ImplicitGeometry g;
+    if (spec.contains("clip") && !readClip(spec["clip"], g, where + ": \"clip\""))
+    {
+      return;
+    }
     try
     {
       std::shared_ptr<voxel::VoxelGrid> grid;
-      const bool vdb = path.size() > 4 && path.compare(path.size() - 4, 4, ".vdb") == 0;
-      if (readers_.volume && !vdb)
+      if (voxel::isCoreVolume(path))
+      {
+        grid = voxel::readCoreVolume(path, array);
+      }
+      else if (readers_.volume)
       {
         grid = readers_.volume(path, array);
-      }
-      else if (vdb)
-      {
-        grid = voxel::readVdb(path, array);
       }
       else
       {
         throw std::invalid_argument("'" + path +
-          "': only .vdb volumes are read without the VTK layer (use ictk or ictkComplexSource)");
+          "': only .vdb and .inv3 volumes are read without the VTK layer (use ictk or "
+          "ictkComplexSource)");
       }
       voxel::validate(*grid, "'" + path + "'");
-      complex::ImplicitGeometry g;
-      g.bounds = grid->bounds();
-      g.inside.push_back(voxel::voxelField(grid, iso, side == "above"));
-      g.insideText.push_back(path + (side == "above" ? " >= " : " <= ") + std::to_string(iso));
+      const Box3 gridBox = grid->bounds();
+      Box3 clipped = gridBox;
+      if (!g.inside.empty())
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          clipped.lo[a] = std::max(gridBox.lo[a], g.bounds.lo[a]);
+          clipped.hi[a] = std::min(gridBox.hi[a], g.bounds.hi[a]);
+          if (clipped.lo[a] >= clipped.hi[a])
+          {
+            throw std::invalid_argument("the clip region does not meet the scan '" + path +
+              "' (on axis " + std::to_string(a) + " the scan spans [" +
+              std::to_string(gridBox.lo[a]) + ", " + std::to_string(gridBox.hi[a]) + "])");
+          }
+        }
+      }
+      g.bounds = clipped;
+      // The scan's field first: the clip fields are the region's faces, and the CGAL backend
+      // protects the curves where the iso-surface meets them (creases between inside fields).
+      g.inside.insert(g.inside.begin(), voxel::voxelField(grid, iso, side == "above"));
+      g.insideText.insert(
+        g.insideText.begin(), path + (side == "above" ? " >= " : " <= ") + std::to_string(iso));
       c.geometry = std::move(g);
     }
     catch (const std::exception& e)
     {
       report(where + ": " + e.what(), current_);
     }
+  }
+
+  /// A voxel cell's clip: {"box": [[lo], [hi]]} or {"inside": [HyperFun...], "bounds": [[lo],
+  /// [hi]]}; its fields become inside fields of the cell (after the scan's) and its box bounds
+  /// the cell.
+  bool readClip(const Json& clip, complex::ImplicitGeometry& g, const std::string& where)
+  {
+    if (!clip.is_object() || (clip.contains("box") == clip.contains("inside")))
+    {
+      report(where +
+          " must be {\"box\": [[lo], [hi]]} or {\"inside\": [HyperFun expressions], "
+          "\"bounds\": [[lo], [hi]]}",
+        current_);
+      return false;
+    }
+    if (clip.contains("box"))
+    {
+      Box3 b;
+      if (!box(clip, "box", b, 3, where))
+      {
+        return false;
+      }
+      // The box as one min of its six planes: its faces split apart again for crease tracing.
+      std::ostringstream text;
+      text.precision(17);
+      auto slab = [&](int a)
+      {
+        text << "min(x[" << a + 1 << "] - (" << b.lo[a] << "), (" << b.hi[a] << ") - x[" << a + 1
+             << "])";
+      };
+      text << "min(min(";
+      slab(0);
+      text << ", ";
+      slab(1);
+      text << "), ";
+      slab(2);
+      text << ")";
+      g.bounds = b;
+      g.insideText.push_back(text.str());
+      g.inside.push_back(field(compile(text.str(), 3, where)));
+      return true;
+    }
+    if (!box(clip, "bounds", g.bounds, 3, where))
+    {
+      return false;
+    }
+    for (const auto& t : strings(clip, "inside", where))
+    {
+      g.insideText.push_back(t);
+      g.inside.push_back(field(compile(t, 3, where)));
+    }
+    return !g.inside.empty();
   }
 
   void readExplicit(const Json& spec, Cell& c, const std::string& where)

@@ -6,6 +6,7 @@
 #include "Complex/Discretization.h"
 #include "FRep/Sampling.h"
 #include "Lang/ComplexFile.h"
+#include "Voxel/VolumeFile.h"
 #include "Voxel/VoxelGrid.h"
 
 #include "vtkCellArray.h"
@@ -225,6 +226,10 @@ complex::ExplicitGeometry readMesh(const std::string& path)
 
 std::shared_ptr<voxel::VoxelGrid> readVolume(const std::string& path, const std::string& array)
 {
+  if (voxel::isCoreVolume(path))
+  {
+    return voxel::readCoreVolume(path, array);
+  }
   vtkSmartPointer<vtkImageData> image;
   if (endsWith(path, ".vti"))
   {
@@ -245,7 +250,8 @@ std::shared_ptr<voxel::VoxelGrid> readVolume(const std::string& path, const std:
   else
   {
     throw std::invalid_argument("'" + path +
-      "': voxel cells are read from .vdb, .vti, .mha/.mhd, .nii/.nii.gz or .nrrd/.nhdr files");
+      "': voxel cells are read from .vdb, .inv3, .vti, .mha/.mhd, .nii/.nii.gz or .nrrd/.nhdr "
+      "files");
   }
   vtkDataArray* scalars = array.empty() ? image->GetPointData()->GetScalars()
                                         : image->GetPointData()->GetArray(array.c_str());

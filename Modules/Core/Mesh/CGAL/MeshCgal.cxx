@@ -869,6 +869,41 @@ std::vector<Polyline> mergeFeatures(
       accepted.push_back(c);
     }
   }
+  // The tracer stops a little short of a trim's zero, so a curve that ends on another one (a
+  // scan's iso-surface meeting a box face, ending at the box's edge: issue 15) can end up to
+  // `duplicate` away from it, at distances from which CGAL makes micro-tetrahedra. Such an end
+  // is extended onto the other curve, where it becomes a corner that splits it.
+  for (std::size_t k = 0; k < accepted.size(); ++k)
+  {
+    if (isClosed(accepted[k]))
+    {
+      continue;
+    }
+    for (const bool back : { false, true })
+    {
+      Polyline& a = accepted[k];
+      const Point3 end = back ? a.back() : a.front();
+      double best = std::numeric_limits<double>::infinity();
+      Point3 onto{};
+      for (std::size_t m = 0; m < accepted.size(); ++m)
+      {
+        const Polyline& b = accepted[m];
+        for (std::size_t i = 1; m != k && i < b.size(); ++i)
+        {
+          const Point3 q = nearestOnSegment(end, b[i - 1], b[i]);
+          if (distance(end, q) < best)
+          {
+            best = distance(end, q);
+            onto = q;
+          }
+        }
+      }
+      if (best > snap && best <= duplicate)
+      {
+        a.insert(back ? a.end() : a.begin(), onto);
+      }
+    }
+  }
   // Corners: end points of open curves, clustered.
   std::vector<Point3> corners;
   auto corner = [&](Point3& p)
