@@ -323,6 +323,7 @@ ComplexRenderResult renderComplex(const complex::Complex& complex, const complex
     const detail::CastCounts counts = detail::cast(canvas, solid, camera, cast);
     result.unresolvedPixels += counts.unresolved;
     result.cutPixels += counts.cut;
+    result.eyeInsidePixels += counts.eyeInside;
     result.intervalEvaluations += counts.intervals;
   }
   progress.report(1);

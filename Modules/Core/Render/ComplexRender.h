@@ -58,7 +58,11 @@ struct ComplexRenderResult
   std::array<std::int64_t, 4> pixelsByDimension{ 0, 0, 0, 0 };
   /// Of the ray-cast cells (RayCastResult's counts, summed).
   std::int64_t unresolvedPixels = 0;
+  /// Rays that start inside a solid where they enter its cell's box (the box is part of the
+  /// cell's definition: this is the cell's face).
   std::int64_t cutPixels = 0;
+  /// Of those, the rays that start inside a solid at the camera: it is inside the cell.
+  std::int64_t eyeInsidePixels = 0;
   std::int64_t intervalEvaluations = 0;
   /// The radii used.
   double tubeRadius = 0;

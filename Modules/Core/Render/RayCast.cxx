@@ -250,8 +250,10 @@ public:
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
-    near_ =
-      std::max(lo, camera.projection() == Projection::Perspective ? 1e-9 * halfDiagonal : 0.0);
+    const double nearest =
+      camera.projection() == Projection::Perspective ? 1e-9 * halfDiagonal : 0.0;
+    near_ = std::max(lo, nearest);
+    eyeInBox_ = lo <= nearest;
     far_ = hi;
     // A canvas that already holds surfaces limits the rays (the common z-buffer).
     limited_ = std::any_of(
@@ -301,6 +303,7 @@ public:
         counts.covered += slot->counts.covered;
         counts.unresolved += slot->counts.unresolved;
         counts.cut += slot->counts.cut;
+        counts.eyeInside += slot->counts.eyeInside;
       }
     }
     return counts;
@@ -381,7 +384,7 @@ private:
           p.j1 = std::max(p.j1, j + 1);
           if (limited_)
           {
-            limit = std::max(limit, canvas_.depth[canvas_.index(i, j)]);
+            limit = std::max(limit, searched(canvas_.depth[canvas_.index(i, j)]));
           }
         }
       }
@@ -393,6 +396,12 @@ private:
     r = p;
     return true;
   }
+
+  /// How far a ray is searched when the canvas holds a surface at distance `held` along it: a
+  /// leaf beyond, so that a solid whose surface lies at the held one (a patch on a solid's
+  /// boundary, a tube along it) is found by a sign change there rather than by halving the
+  /// pieces in front of it down to the depth tolerance; hits beyond `held` are not drawn.
+  double searched(double held) const { return held + footprint(held); }
 
   /// The lateral size of one pixel at depth s.
   double footprint(double s) const
@@ -508,7 +517,7 @@ private:
     }
     if (limited_)
     {
-      exit = std::min(exit, canvas_.depth[canvas_.index(i, j)] / ray.length);
+      exit = std::min(exit, searched(canvas_.depth[canvas_.index(i, j)]) / ray.length);
     }
     ray.start = entry;
     s0 = std::max(s0, entry);
@@ -624,6 +633,7 @@ private:
     if (hit(ws, stage, ray, s, inside, false))
     {
       ws.counts.cut += s == ray.start ? 1 : 0;
+      ws.counts.eyeInside += s == ray.start && eyeInBox_ && ray.start == near_ ? 1 : 0;
     }
   }
 
@@ -654,6 +664,7 @@ private:
   double near_ = 0;
   double far_ = 0;
   bool limited_ = false;
+  bool eyeInBox_ = false; // rays start at the camera, not where they enter the box
 };
 
 void checkBox(const Box3& box)

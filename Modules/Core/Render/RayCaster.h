@@ -64,6 +64,8 @@ struct CastCounts
   std::int64_t covered = 0;
   std::int64_t unresolved = 0;
   std::int64_t cut = 0;
+  /// Of `cut`, the rays cut by the camera itself: it is inside the solid.
+  std::int64_t eyeInside = 0;
   std::int64_t intervals = 0;
   std::int64_t points = 0;
 };
