@@ -375,6 +375,12 @@ private:
       else
       {
         loaded = LoadComplex(this->Model);
+        this->Guarded(
+          [&]
+          {
+            render::checkColours(loaded, this->Colours);
+            return Drawn{};
+          });
         complex::DiscretizationOptions o;
         o.featureSize = this->FeatureSize;
         o.threads = this->Threads;

@@ -238,11 +238,17 @@ std::vector<CellId> meshedCells(const complex::Complex& complex)
   return ids;
 }
 
+void checkColours(const complex::Complex& complex, const ColourOptions& colours)
+{
+  colouringOf(complex, colours.attribute);
+  ColourMap::named(colours.map);
+}
+
 ComplexRenderResult renderComplex(const complex::Complex& complex, const complex::ComplexMesh& mesh,
   const Camera& camera, const ComplexRenderOptions& options)
 {
+  checkColours(complex, options.colours); // before the work
   const Colouring colouring = colouringOf(complex, options.colours.attribute);
-  ColourMap::named(options.colours.map); // an unknown map fails before the work
   for (double r : { options.tubeRadius, options.pointRadius })
   {
     if (!std::isfinite(r) || r < 0)

@@ -78,6 +78,11 @@ bool isRayCast(const complex::Cell& cell);
 /// The cells whose discretisation renderComplex needs: every cell that is not ray cast.
 std::vector<complex::CellId> meshedCells(const complex::Complex& complex);
 
+/// Throws std::invalid_argument unless the options colour the complex: an attribute it declares
+/// with 1, 3 or 4 components (or none named), a known colour map. renderComplex checks the
+/// same; this is for checking before the discretisation it needs.
+void checkColours(const complex::Complex& complex, const ColourOptions& colours);
+
 /// The complex seen by `camera` (see the file comment). `mesh` holds the discretisation of every
 /// cell of meshedCells() (more is fine). Throws std::invalid_argument for a missing
 /// discretisation, an attribute the complex does not declare or that is neither a colour nor a

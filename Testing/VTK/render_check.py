@@ -1,0 +1,179 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""Runs `ictk render` on complexes, dynamic models and frame ranges as a user would and checks
+what it prints and writes (the FRep model pictures are ictk_cli_check.py's `render`).
+
+Usage: render_check.py --ictk PATH --work DIR --data DATA CHECK
+  flower | icm | frames | film | interrupt | inside
+"""
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ictk_cli_check import no_leftovers, run  # noqa: E402
+
+
+def read_png(path):
+    import vtk
+    r = vtk.vtkPNGReader()
+    r.SetFileName(path)
+    r.Update()
+    image = r.GetOutput()
+    scalars = image.GetPointData().GetScalars()
+    w, h, _ = image.GetDimensions()
+    pixels = [tuple(int(scalars.GetComponent(i, c)) for c in range(4)) for i in range(w * h)]
+    return w, h, pixels
+
+
+def by_dimension(stdout):
+    m = re.search(r"(\d+) pixels covered: (\d+) by 0D cells, (\d+) 1D, (\d+) 2D, (\d+) 3D", stdout)
+    if not m:
+        sys.exit(f"FAIL: no pixel counts by dimension in:\n{stdout}")
+    covered, *dims = (int(g) for g in m.groups())
+    if covered != sum(dims):
+        sys.exit(f"FAIL: {covered} covered but {dims} by dimension")
+    return covered, dims
+
+
+def check_flower(ictk, work, data):
+    """The flower with every cell dimension in view, its colours from the complex's attribute."""
+    png = os.path.join(work, "flower.png")
+    p = run(ictk, ["render", os.path.join(data, "Models/flower/flower.json"), "-o", png,
+                   "--size", "96,72", "--view", "-70,25", "--threads", "2"])
+    covered, dims = by_dimension(p.stdout)
+    if min(dims) <= 0:
+        sys.exit(f"FAIL: a cell dimension is not in view: {dims}")
+    w, h, pixels = read_png(png)
+    opaque = [q for q in pixels if q[3] == 255]
+    if (w, h) != (96, 72) or len(opaque) != covered:
+        sys.exit(f"FAIL: {w} x {h} with {len(opaque)} opaque pixels, {covered} reported")
+    # The receptacle is green (S2: 0.3, 0.55 + 0.3 z, 0.25) and the pistil yellow: both show.
+    green = sum(1 for r, g, b, a in opaque if g > r and g > b)
+    yellow = sum(1 for r, g, b, a in opaque if r > b and g > b and r >= g)
+    if green < 100 or yellow < 100:
+        sys.exit(f"FAIL: {green} green and {yellow} yellow pixels")
+    # The attribute by name gives the same picture; an undeclared one is refused.
+    again = os.path.join(work, "again.png")
+    run(ictk, ["render", os.path.join(data, "Models/flower/flower.json"), "-o", again,
+               "--size", "96,72", "--view", "-70,25", "--threads", "1", "--colour-by", "colour"])
+    if read_png(again)[2] != pixels:
+        sys.exit("FAIL: --colour-by colour (or one thread) changed the picture")
+    no_leftovers(work)
+
+
+def check_icm(ictk, work, data):
+    """A .icm model at --time: its curves, points and patches at that time."""
+    png = os.path.join(work, "dependency.png")
+    p = run(ictk, ["render", os.path.join(data, "Models/icm/ch5_2_dependency.icm"), "-o", png,
+                   "--size", "120,90", "--time", "2"])
+    covered, dims = by_dimension(p.stdout)
+    if dims[0] <= 0 or dims[1] <= 0 or dims[2] <= 0:
+        sys.exit(f"FAIL: the points, the curve and the patches are not all in view: {dims}")
+    # Without --time: the model's start, a different picture (the cells move).
+    start = os.path.join(work, "start.png")
+    run(ictk, ["render", os.path.join(data, "Models/icm/ch5_2_dependency.icm"), "-o", start,
+               "--size", "120,90"])
+    if read_png(start)[2] == read_png(png)[2]:
+        sys.exit("FAIL: the picture at t = 2 is the one at the start")
+    no_leftovers(work)
+
+
+def check_frames(ictk, work, data):
+    """--frames to numbered PNGs: one per frame, the pattern's folder made, nothing else left."""
+    icm = os.path.join(data, "Models/icm/ch5_1_disk_rectangle.icm")
+    pattern = os.path.join(work, "frames", "%02d.png")
+    p = run(ictk, ["render", icm, "--frames", "0:1:0.5", "-o", pattern, "--size", "40,30"])
+    names = sorted(os.listdir(os.path.join(work, "frames")))
+    if names != ["00.png", "01.png", "02.png"]:
+        sys.exit(f"FAIL: frames {names}")
+    if "3 frame(s)" not in p.stdout:
+        sys.exit(f"FAIL: the summary:\n{p.stdout}")
+    pictures = [read_png(os.path.join(work, "frames", n)) for n in names]
+    if any(w != 40 or h != 30 for w, h, _ in pictures) or pictures[0][2] == pictures[2][2]:
+        sys.exit("FAIL: the frames are not 40 x 30, or the disk did not move")
+    # An XYZT model's frames.
+    run(ictk, ["render", "morph", "--frames", "0:1:0.5", "-o", os.path.join(work, "m%d.png"),
+               "--size", "20,20"])
+    for k in range(3):
+        if not os.path.exists(os.path.join(work, f"m{k}.png")):
+            sys.exit(f"FAIL: no frame m{k}.png")
+    no_leftovers(work)
+    no_leftovers(os.path.join(work, "frames"))
+
+
+def check_film(ictk, work, data):
+    """--frames to an .mp4 film through ffmpeg: the frames and an even size, nothing left."""
+    if shutil.which("ffmpeg") is None or shutil.which("ffprobe") is None:
+        print("SKIP: ffmpeg is not installed")
+        return
+    icm = os.path.join(data, "Models/icm/ch5_1_disk_rectangle.icm")
+    film = os.path.join(work, "disk.mp4")
+    run(ictk, ["render", icm, "--frames", "0:2:0.5", "-o", film, "--size", "41,31", "--fps", "4"])
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+                            "-show_entries", "stream=nb_read_frames,width,height,r_frame_rate",
+                            "-of", "csv=p=0", film], capture_output=True, text=True, check=True)
+    if probe.stdout.strip() != "42,32,4/1,5":
+        sys.exit(f"FAIL: the film is {probe.stdout.strip()!r}, not 42 x 32 at 4/1 with 5 frames")
+    if sorted(os.listdir(work)) != ["disk.mp4"]:
+        sys.exit(f"FAIL: left behind: {os.listdir(work)}")
+
+
+def check_interrupt(ictk, work, data):
+    """Ctrl-C during a range of frames: exit code 130 and nothing written, not even the folder."""
+    pattern = os.path.join(work, "frames", "%03d.png")
+    p = subprocess.Popen([ictk, "render", "morph", "--frames", "0:1:0.002", "-o", pattern,
+                          "--size", "200,150", "--threads", "1"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # The progress lines come at every quarter (stderr is not a terminal): stop after the first.
+    line = p.stderr.readline()
+    if "%" not in line:
+        p.kill()
+        sys.exit(f"FAIL: no progress line, got {line!r}")
+    p.send_signal(signal.SIGINT)
+    try:
+        _, err = p.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        sys.exit("FAIL: Ctrl-C did not stop the render")
+    if p.returncode != 130 or "interrupted; nothing written" not in err:
+        sys.exit(f"FAIL: exit {p.returncode}\n{err}")
+    if os.listdir(work):
+        sys.exit(f"FAIL: left behind: {os.listdir(work)}")
+
+
+def check_inside(ictk, work, data):
+    """A camera inside a 3D cell: the picture of its solid from inside, with a warning."""
+    ball = os.path.join(work, "ball.json")
+    with open(ball, "w") as f:
+        f.write('{"ictk_complex": 1, "name": "ball", "cells": [{"name": "ball", "kind": "F", '
+                '"dimension": 3, "inside": ["1 - x[1]*x[1] - x[2]*x[2] - x[3]*x[3]"], '
+                '"bounds": [[-1, -1, -1], [1, 1, 1]]}]}')
+    p = run(ictk, ["render", ball, "-o", os.path.join(work, "inside.png"), "--size", "8,8",
+                   "--view", "0,0,0.1"])
+    if "ictk: warning: 64 pixel(s) see" not in p.stderr or "inside" not in p.stderr:
+        sys.exit(f"FAIL: no warning for a camera inside a cell:\n{p.stderr}")
+    no_leftovers(work)
+
+
+def main():
+    argv = sys.argv[1:]
+    if len(argv) != 7 or argv[0] != "--ictk" or argv[2] != "--work" or argv[4] != "--data":
+        sys.exit(__doc__)
+    ictk, work, data, check = argv[1], argv[3], argv[5], argv[6]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    checks = {"flower": check_flower, "icm": check_icm, "frames": check_frames,
+              "film": check_film, "interrupt": check_interrupt, "inside": check_inside}
+    if check not in checks:
+        sys.exit(f"unknown check {check!r}")
+    checks[check](ictk, work, data)
+    print("OK")
+
+
+if __name__ == "__main__":
+    main()
