@@ -5,6 +5,7 @@
 // a range of frames of an XYZT model or a .icm model as numbered PNGs or an .mp4 film. This
 // file resolves the input, the camera and the colours; Pictures.h writes the results.
 #include "Command.h"
+#include "MeshPicture.h"
 #include "Models.h"
 #include "Options.h"
 #include "Pictures.h"
@@ -50,6 +51,7 @@ struct Drawn
   std::optional<std::array<std::int64_t, 4>> ByDimension;
   std::array<double, 2> ScalarRange{ std::numeric_limits<double>::quiet_NaN(),
     std::numeric_limits<double>::quiet_NaN() };
+  bool Mesh = false; ///< drawn by VTK's polygon pipeline (--mode mesh)
 
   PictureBuffers Buffers() const { return { Width, Height, &Colour, &Depth }; }
 };
@@ -131,6 +133,10 @@ public:
     render->add_option("--feature-size", this->FeatureSize,
       "Edge length of the discretisation of a complex's cells that are not ray cast (default "
       "1/64 of the complex's largest side)");
+    render->add_option("--mode", this->Mode,
+      "raycast (default: solids ray cast exactly, meshed cells rasterised exactly) or mesh "
+      "(every cell's discretisation through VTK's OpenGL pipeline offscreen; complexes only, "
+      "needs an X display or xvfb-run)");
     render->add_option("--depth", this->Depth,
       "Also write the depth buffer (distance along each pixel's ray, inf where nothing is hit) "
       "as .vti");
@@ -206,6 +212,14 @@ private:
     {
       throw UserError(
         "--projection must be perspective or orthographic, got '" + this->Projection + "'");
+    }
+    if (this->Mode != "raycast" && this->Mode != "mesh")
+    {
+      throw UserError("--mode must be raycast or mesh, got '" + this->Mode + "'");
+    }
+    if (this->Mode == "mesh" && (IsComplexInput(this->Model) || HasExtension(this->Model, ".icm")))
+    {
+      CheckMeshDisplay();
     }
     if (!std::isfinite(this->Time))
     {
@@ -318,6 +332,23 @@ private:
     options.pointRadius = this->PointRadius;
     options.colours = this->Colours;
     options.progress = progress;
+    if (this->Mode == "mesh")
+    {
+      return Guarded(
+        [&]
+        {
+          render::Canvas c = DrawMeshes(
+            render::scenePrimitives(complex, mesh, options, true), camera, this->Colours);
+          Drawn d;
+          d.Width = c.width;
+          d.Height = c.height;
+          d.Covered = c.covered();
+          d.Colour = std::move(c.colour);
+          d.Depth = std::move(c.depth);
+          d.Mesh = true;
+          return d;
+        });
+    }
     return Guarded(
       [&] { return FromComplex(render::renderComplex(complex, mesh, camera, options)); });
   }
@@ -385,6 +416,10 @@ private:
         o.featureSize = this->FeatureSize;
         o.threads = this->Threads;
         o.cells = render::meshedCells(loaded);
+        if (this->Mode == "mesh")
+        {
+          o.cells = loaded.cellIds(); // the solids are drawn from their boundary meshes too
+        }
         o.progress = show(0, 0.5);
         if (!o.cells.empty())
         {
@@ -398,6 +433,11 @@ private:
     }
     else
     {
+      if (this->Mode == "mesh")
+      {
+        throw UserError(
+          "--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
+      }
       const ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
       name = model.Name;
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
@@ -496,9 +536,10 @@ private:
     }
     else
     {
-      if (IsComplexInput(this->Model))
+      if (this->Mode == "mesh")
       {
-        throw UserError("--frames: '" + this->Model + "' is a .json complex, which has no time");
+        throw UserError(
+          "--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
       }
       const ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
@@ -539,8 +580,11 @@ private:
     {
       os << " (" << d.Unresolved << " unresolved)";
     }
-    os << ", " << std::fixed << std::setprecision(1) << d.IntervalsPerPixel
-       << " interval evaluations per pixel";
+    if (!d.Mesh)
+    {
+      os << ", " << std::fixed << std::setprecision(1) << d.IntervalsPerPixel
+         << " interval evaluations per pixel";
+    }
     if (!std::isnan(d.ScalarRange[0]))
     {
       os << std::defaultfloat << std::setprecision(6) << ", colour map over [" << d.ScalarRange[0]
@@ -587,6 +631,7 @@ private:
   double TubeRadius = 0;
   double PointRadius = 0;
   double FeatureSize = 0;
+  std::string Mode = "raycast";
   std::string Depth;
   // Checked values.
   int Width = 0;

@@ -4,8 +4,10 @@
 what it prints and writes (the FRep model pictures are ictk_cli_check.py's `render`).
 
 Usage: render_check.py --ictk PATH --work DIR --data DATA CHECK
-  flower | icm | frames | film | interrupt | inside
+  flower | icm | frames | film | interrupt | inside | mesh
+mesh needs an X display (run it under Testing/ParaView/run_checked.py --xvfb).
 """
+import math
 import os
 import re
 import shutil
@@ -160,6 +162,55 @@ def check_inside(ictk, work, data):
     no_leftovers(work)
 
 
+def read_depth(path):
+    import vtk
+    r = vtk.vtkXMLImageDataReader()
+    r.SetFileName(path)
+    r.Update()
+    a = r.GetOutput().GetPointData().GetArray("depth")
+    return [a.GetValue(i) for i in range(a.GetNumberOfTuples())]
+
+
+def check_mesh(ictk, work, data):
+    """The flower ray cast and through VTK's polygon pipeline (--mode mesh): the coverage masks
+    agree on at least 99 % of the pixels, and where both are covered the depths agree within a
+    pixel's footprint, except next to a silhouette (a jump of the ray-cast depth to a neighbour),
+    where the two may see different surfaces."""
+    w, h = 160, 120
+    flower = os.path.join(data, "Models/flower/flower.json")
+    depth = {}
+    for mode in ("raycast", "mesh"):
+        png, vti = os.path.join(work, mode + ".png"), os.path.join(work, mode + ".vti")
+        run(ictk, ["render", flower, "-o", png, "--depth", vti, "--size", f"{w},{h}",
+                   "--view", "-70,25", "--mode", mode])
+        depth[mode] = read_depth(vti)
+    ray, mesh = depth["raycast"], depth["mesh"]
+    agree = sum(1 for a, b in zip(ray, mesh) if math.isfinite(a) == math.isfinite(b))
+    print(f"coverage agrees on {agree} of {w * h} pixels")
+    if agree < 0.99 * w * h:
+        sys.exit(f"FAIL: coverage agrees on {agree} of {w * h} pixels only")
+    pixel = 2 * math.tan(math.radians(15)) / h  # a pixel's side at distance 1 (30 degrees high)
+    both = off = 0
+    for k, (a, b) in enumerate(zip(ray, mesh)):
+        if not (math.isfinite(a) and math.isfinite(b)):
+            continue
+        both += 1
+        footprint = pixel * a
+        if abs(a - b) <= footprint:
+            continue
+        i, j = k % w, k // w
+        near = [ray[jj * w + ii] for ii, jj in ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1))
+                if 0 <= ii < w and 0 <= jj < h]
+        if not any(not math.isfinite(n) or abs(n - a) > 3 * footprint for n in near):
+            sys.exit(f"FAIL: pixel {i},{j}: depths {a} (ray cast) and {b} (mesh) differ by more "
+                     f"than a footprint ({footprint}) away from any silhouette")
+        off += 1
+    print(f"depths agree within a footprint on {both - off} of {both} pixels covered by both")
+    if off > 0.005 * both:
+        sys.exit(f"FAIL: {off} of {both} depths differ by more than a footprint")
+    print("all checks passed")
+
+
 def main():
     argv = sys.argv[1:]
     if len(argv) != 7 or argv[0] != "--ictk" or argv[2] != "--work" or argv[4] != "--data":
@@ -168,7 +219,8 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     checks = {"flower": check_flower, "icm": check_icm, "frames": check_frames,
-              "film": check_film, "interrupt": check_interrupt, "inside": check_inside}
+              "film": check_film, "interrupt": check_interrupt, "inside": check_inside,
+              "mesh": check_mesh}
     if check not in checks:
         sys.exit(f"unknown check {check!r}")
     checks[check](ictk, work, data)

@@ -244,10 +244,10 @@ void checkColours(const complex::Complex& complex, const ColourOptions& colours)
   ColourMap::named(colours.map);
 }
 
-ComplexRenderResult renderComplex(const complex::Complex& complex, const complex::ComplexMesh& mesh,
-  const Camera& camera, const ComplexRenderOptions& options)
+ScenePrimitives scenePrimitives(const complex::Complex& complex, const complex::ComplexMesh& mesh,
+  const ComplexRenderOptions& options, bool everyCell)
 {
-  checkColours(complex, options.colours); // before the work
+  checkColours(complex, options.colours);
   const Colouring colouring = colouringOf(complex, options.colours.attribute);
   for (double r : { options.tubeRadius, options.pointRadius })
   {
@@ -256,25 +256,20 @@ ComplexRenderResult renderComplex(const complex::Complex& complex, const complex
       throw std::invalid_argument("the tube and point radii must be finite and >= 0 (0: default)");
     }
   }
-  ComplexRenderResult result;
+  ScenePrimitives scene;
+  scene.scalar = colouring.scalar;
   const frep::Box3 box = complex::complexBounds(complex);
   const double halfDiagonal = 0.5 * frep::norm(frep::sub(box.hi, box.lo));
-  result.tubeRadius = options.tubeRadius > 0
+  scene.tubeRadius = options.tubeRadius > 0
     ? options.tubeRadius
     : (std::isfinite(halfDiagonal) && halfDiagonal > 0 ? halfDiagonal / 200 : 0.005);
-  result.pointRadius = options.pointRadius > 0 ? options.pointRadius : 2.5 * result.tubeRadius;
-  result.canvas = Canvas(camera.width(), camera.height(),
-    colouring.scalar ? Canvas::Colouring::Scalar : Canvas::Colouring::Rgb);
-  Canvas& canvas = result.canvas;
-
-  std::vector<CellId> rayCast;
-  std::vector<Primitives> meshed;
+  scene.pointRadius = options.pointRadius > 0 ? options.pointRadius : 2.5 * scene.tubeRadius;
   for (CellId id : complex.cellIds())
   {
     const Cell& cell = complex.cell(id);
-    if (isRayCast(cell))
+    if (!everyCell && isRayCast(cell))
     {
-      rayCast.push_back(id);
+      scene.rayCast.push_back(id);
       continue;
     }
     const complex::CellMesh* cellMesh = nullptr;
@@ -286,9 +281,25 @@ ComplexRenderResult renderComplex(const complex::Complex& complex, const complex
     {
       throw std::invalid_argument("renderComplex: no discretisation of cell '" + cell.name + "'");
     }
-    meshed.push_back(
-      primitivesOf(cell, *cellMesh, colouring, result.tubeRadius, result.pointRadius));
+    scene.meshed.push_back(
+      primitivesOf(cell, *cellMesh, colouring, scene.tubeRadius, scene.pointRadius));
   }
+  return scene;
+}
+
+ComplexRenderResult renderComplex(const complex::Complex& complex, const complex::ComplexMesh& mesh,
+  const Camera& camera, const ComplexRenderOptions& options)
+{
+  const Colouring colouring = colouringOf(complex, options.colours.attribute);
+  const ScenePrimitives scene = scenePrimitives(complex, mesh, options, false);
+  ComplexRenderResult result;
+  result.tubeRadius = scene.tubeRadius;
+  result.pointRadius = scene.pointRadius;
+  result.canvas = Canvas(camera.width(), camera.height(),
+    scene.scalar ? Canvas::Colouring::Scalar : Canvas::Colouring::Rgb);
+  Canvas& canvas = result.canvas;
+  const std::vector<CellId>& rayCast = scene.rayCast;
+  const std::vector<Primitives>& meshed = scene.meshed;
 
   ProgressScope progress(options.progress);
   progress.report(0);

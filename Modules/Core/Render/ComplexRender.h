@@ -28,6 +28,7 @@
 #include "FRep/Progress.h"
 #include "Render/Camera.h"
 #include "Render/Canvas.h"
+#include "Render/Rasterize.h"
 
 #include <array>
 #include <cstdint>
@@ -82,6 +83,23 @@ std::vector<complex::CellId> meshedCells(const complex::Complex& complex);
 /// with 1, 3 or 4 components (or none named), a known colour map. renderComplex checks the
 /// same; this is for checking before the discretisation it needs.
 void checkColours(const complex::Complex& complex, const ColourOptions& colours);
+
+/// What pass A draws: the meshed cells as primitives (owner: the cell id) with their paints, the
+/// radii used, and the cells pass B ray casts.
+struct ScenePrimitives
+{
+  std::vector<Primitives> meshed;
+  std::vector<complex::CellId> rayCast;
+  bool scalar = false; ///< the paints are scalars (else colours)
+  double tubeRadius = 0;
+  double pointRadius = 0;
+};
+
+/// The primitives of renderComplex's pass A; `everyCell`: every cell from its discretisation (3D
+/// field cells by their boundary too), the polygonal scene of `ictk render --mode mesh`. Throws
+/// as renderComplex does.
+ScenePrimitives scenePrimitives(const complex::Complex& complex, const complex::ComplexMesh& mesh,
+  const ComplexRenderOptions& options, bool everyCell);
 
 /// The complex seen by `camera` (see the file comment). `mesh` holds the discretisation of every
 /// cell of meshedCells() (more is fine). Throws std::invalid_argument for a missing
