@@ -213,7 +213,7 @@ render::Canvas DrawMeshes(const render::ScenePrimitives& scene, const render::Ca
   const bool perspective = camera.projection() == render::Projection::Perspective;
   if (perspective)
   {
-    view->SetViewAngle(render::PerspectiveFieldOfView);
+    view->SetViewAngle(camera.viewAngle());
   }
   else
   {

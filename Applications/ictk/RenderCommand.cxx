@@ -17,10 +17,12 @@
 #include "Render/RayCast.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <iostream>
@@ -103,12 +105,16 @@ public:
       "Output picture (.png); with --frames a pattern (frames/%04d.png) or an .mp4 film");
     render->add_option(
       "--size", this->Size, "Image size W,H in pixels, 1..4096 each (default 800,600)");
-    render->add_option("--view", this->View,
+    this->ViewOption = render->add_option("--view", this->View,
       "Camera: azimuth,elevation[,distance]: degrees about +z from +x, degrees above the "
       "xy-plane, distance from the centre of the model's box (default 30,20 and 2.5 times the "
       "box's half-diagonal)");
-    render->add_option(
+    this->ProjectionOption = render->add_option(
       "--projection", this->Projection, "perspective (default; 30 degrees high) or orthographic");
+    render->add_option("--camera", this->CameraFile,
+      "A camera file (JSON, VTK's conventions): position, focal_point, up (default 0,0,1), "
+      "projection (perspective or orthographic), view_angle (degrees, default 30) or "
+      "parallel_scale (half the height seen); instead of --view and --projection");
     this->TimeOption = AddTime(render, this->Time);
     this->TimeOption->description(
       "Time t of an XYZT model or a .icm model (default 0; a .icm model's start)");
@@ -213,6 +219,14 @@ private:
       throw UserError(
         "--projection must be perspective or orthographic, got '" + this->Projection + "'");
     }
+    if (!this->CameraFile.empty())
+    {
+      if (this->ViewOption->count() > 0 || this->ProjectionOption->count() > 0)
+      {
+        throw UserError("--camera and --view/--projection: the camera file says where it is");
+      }
+      this->ReadCamera();
+    }
     if (this->Mode != "raycast" && this->Mode != "mesh")
     {
       throw UserError("--mode must be raycast or mesh, got '" + this->Mode + "'");
@@ -284,10 +298,101 @@ private:
     }
   }
 
+  /// Reads --camera's file into LookAt (UserErrors name the file and the key).
+  void ReadCamera()
+  {
+    const std::string& file = this->CameraFile;
+    std::ifstream in(file);
+    if (!in)
+    {
+      throw UserError("--camera: cannot read '" + file + "'");
+    }
+    nlohmann::json j;
+    try
+    {
+      in >> j;
+    }
+    catch (const nlohmann::json::exception& e)
+    {
+      throw UserError("--camera: '" + file + "' is not JSON: " + e.what());
+    }
+    if (!j.is_object())
+    {
+      throw UserError("--camera: '" + file + "' is not a JSON object");
+    }
+    static const std::vector<std::string> keys{ "position", "focal_point", "up", "projection",
+      "view_angle", "parallel_scale" };
+    for (const auto& item : j.items())
+    {
+      if (std::find(keys.begin(), keys.end(), item.key()) == keys.end())
+      {
+        throw UserError("--camera: '" + file + "': unknown key '" + item.key() +
+          "' (known: position, focal_point, up, projection, view_angle, parallel_scale)");
+      }
+    }
+    auto point = [&](const char* key, std::optional<frep::Point3> fallback)
+    {
+      if (!j.contains(key))
+      {
+        if (!fallback)
+        {
+          throw UserError("--camera: '" + file + "' has no '" + key + "'");
+        }
+        return *fallback;
+      }
+      const nlohmann::json& v = j[key];
+      if (!v.is_array() || v.size() != 3 ||
+        !std::all_of(v.begin(), v.end(), [](const nlohmann::json& x) { return x.is_number(); }))
+      {
+        throw UserError("--camera: '" + file + "': '" + key + "' must be 3 numbers");
+      }
+      return frep::Point3{ v[0].get<double>(), v[1].get<double>(), v[2].get<double>() };
+    };
+    auto number = [&](const char* key, double fallback)
+    {
+      if (!j.contains(key))
+      {
+        return fallback;
+      }
+      if (!j[key].is_number())
+      {
+        throw UserError("--camera: '" + file + "': '" + key + "' must be a number");
+      }
+      return j[key].get<double>();
+    };
+    CameraSpec c;
+    c.Position = point("position", std::nullopt);
+    c.FocalPoint = point("focal_point", std::nullopt);
+    c.Up = point("up", frep::Point3{ 0, 0, 1 });
+    const std::string projection = j.value("projection", std::string("perspective"));
+    if (projection == "orthographic")
+    {
+      c.Kind = render::Projection::Orthographic;
+      if (!j.contains("parallel_scale"))
+      {
+        throw UserError("--camera: '" + file + "': an orthographic camera needs 'parallel_scale'");
+      }
+    }
+    else if (projection != "perspective")
+    {
+      throw UserError("--camera: '" + file + "': projection must be perspective or orthographic");
+    }
+    c.ViewAngle = number("view_angle", render::PerspectiveFieldOfView);
+    c.ParallelScale = number("parallel_scale", 0);
+    this->LookAt = c;
+    this->MakeCamera({}); // checks the values now, before any work
+  }
+
   render::Camera MakeCamera(const frep::Box3& box) const
   {
     try
     {
+      if (this->LookAt)
+      {
+        const CameraSpec& c = *this->LookAt;
+        return render::Camera::lookAt(c.Position, c.FocalPoint, c.Up, c.Kind, c.ViewAngle,
+          c.ParallelScale, this->Width, this->Height);
+      }
       return render::Camera::orbit(box, this->Orbit, this->Kind, this->Width, this->Height);
     }
     catch (const std::invalid_argument& e)
@@ -632,6 +737,19 @@ private:
   double PointRadius = 0;
   double FeatureSize = 0;
   std::string Mode = "raycast";
+  std::string CameraFile;
+  CLI::Option* ViewOption = nullptr;
+  CLI::Option* ProjectionOption = nullptr;
+  struct CameraSpec
+  {
+    frep::Point3 Position{};
+    frep::Point3 FocalPoint{};
+    frep::Point3 Up{};
+    render::Projection Kind = render::Projection::Perspective;
+    double ViewAngle = 0;
+    double ParallelScale = 0;
+  };
+  std::optional<CameraSpec> LookAt;
   std::string Depth;
   // Checked values.
   int Width = 0;

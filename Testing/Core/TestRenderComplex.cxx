@@ -393,3 +393,41 @@ TEST(RenderRayCast, WalnutMaterialsThroughColourMap)
   options.colours.attribute = "temperature";
   EXPECT_THROW(rayCast(walnut, box, camera, options), std::invalid_argument);
 }
+
+TEST(RenderCamera, LookAtIsTheOrbitGivenItsValues)
+{
+  // The orbit's camera of view 30,20,4 about the cube, restated as position, focal point and up.
+  const Box3 cube{ { -1, -1, -1 }, { 1, 1, 1 } };
+  for (Projection p : { Projection::Perspective, Projection::Orthographic })
+  {
+    const Camera a = Camera::orbit(cube, View{ 30, 20, 4 }, p, 40, 30);
+    const Camera b = Camera::lookAt(a.eye(), add(a.eye(), a.forward()), { 0, 0, 1 }, p,
+      PerspectiveFieldOfView, 0.5 * OrthographicHeight * std::sqrt(3.0), 40, 30);
+    for (int k = 0; k < 3; ++k)
+    {
+      EXPECT_NEAR(a.forward()[k], b.forward()[k], 1e-15);
+      EXPECT_NEAR(a.right()[k], b.right()[k], 1e-15);
+      EXPECT_NEAR(a.up()[k], b.up()[k], 1e-15);
+    }
+    EXPECT_NEAR(a.pixelSize(), b.pixelSize(), 1e-15);
+    EXPECT_NEAR(b.viewAngle(), p == Projection::Perspective ? 30 : b.viewAngle(), 1e-12);
+  }
+  // A hand-made one: from (0, 0, 5) looking down at the origin with +y up, 90 degrees high.
+  const Camera c =
+    Camera::lookAt({ 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, Projection::Perspective, 90, 0, 10, 10);
+  EXPECT_NEAR(c.right()[0], 1, 1e-15);
+  EXPECT_NEAR(c.up()[1], 1, 1e-15);
+  EXPECT_NEAR(c.pixelSize(), 0.2, 1e-15);
+  EXPECT_THROW(
+    Camera::lookAt({ 0, 0, 5 }, { 0, 0, 5 }, { 0, 1, 0 }, Projection::Perspective, 30, 0, 8, 8),
+    std::invalid_argument);
+  EXPECT_THROW(
+    Camera::lookAt({ 0, 0, 5 }, { 0, 0, 0 }, { 0, 0, 1 }, Projection::Perspective, 30, 0, 8, 8),
+    std::invalid_argument);
+  EXPECT_THROW(
+    Camera::lookAt({ 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, Projection::Perspective, 180, 0, 8, 8),
+    std::invalid_argument);
+  EXPECT_THROW(
+    Camera::lookAt({ 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, Projection::Orthographic, 30, 0, 8, 8),
+    std::invalid_argument);
+}

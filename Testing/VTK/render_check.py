@@ -4,7 +4,7 @@
 what it prints and writes (the FRep model pictures are ictk_cli_check.py's `render`).
 
 Usage: render_check.py --ictk PATH --work DIR --data DATA CHECK
-  flower | icm | frames | film | interrupt | inside | mesh
+  flower | icm | frames | film | interrupt | inside | camera | mesh
 mesh needs an X display (run it under Testing/ParaView/run_checked.py --xvfb).
 """
 import math
@@ -162,6 +162,43 @@ def check_inside(ictk, work, data):
     no_leftovers(work)
 
 
+def check_camera(ictk, work, data):
+    """A camera file that restates --view's camera gives the same picture, bit for bit; the
+    orthographic one with the orbit's parallel scale too; bad files are refused by name."""
+    import json
+    models = json.loads(run(ictk, ["models", "--json"]).stdout)
+    b = [m for m in models if m["name"] == "walnut"][0]["bounds"]
+    centre = [0.5 * (b[2 * a] + b[2 * a + 1]) for a in range(3)]
+    half = 0.5 * math.sqrt(sum((b[2 * a + 1] - b[2 * a]) ** 2 for a in range(3)))
+    for projection, extra in (("perspective", {"view_angle": 30}),
+                              ("orthographic", {"parallel_scale": 1.1 * half})):
+        camera = dict(position=[centre[0] + 4, centre[1], centre[2]], focal_point=centre,
+                      up=[0, 0, 1], projection=projection, **extra)
+        path = os.path.join(work, projection + ".json")
+        with open(path, "w") as f:
+            json.dump(camera, f)
+        a, c = os.path.join(work, "view.png"), os.path.join(work, "camera.png")
+        run(ictk, ["render", "walnut", "-o", a, "--size", "32,24", "--view", "0,0,4",
+                   "--projection", projection])
+        run(ictk, ["render", "walnut", "-o", c, "--size", "32,24", "--camera", path])
+        if read_png(a)[2] != read_png(c)[2]:
+            sys.exit(f"FAIL: the {projection} camera file does not give --view's picture")
+    bad = os.path.join(work, "bad.json")
+    for text, message in (('{"position": [0, 0, 5]}', "has no 'focal_point'"),
+                          ('{"position": [0, 0, 5], "focal_point": [0, 0, 0], "zoom": 2}',
+                           "unknown key 'zoom'"),
+                          ('{"position": [0, 0, 5], "focal_point": [0, 0, 0]}',
+                           "up is zero or along its view direction"),
+                          ('[1, 2]', "is not a JSON object")):
+        with open(bad, "w") as f:
+            f.write(text)
+        p = run(ictk, ["render", "walnut", "-o", os.path.join(work, "x.png"), "--camera", bad],
+                check=False)
+        if p.returncode != 2 or message not in p.stderr:
+            sys.exit(f"FAIL: {text}: exit {p.returncode}, {p.stderr!r} lacks {message!r}")
+    no_leftovers(work)
+
+
 def read_depth(path):
     import vtk
     r = vtk.vtkXMLImageDataReader()
@@ -220,7 +257,7 @@ def main():
     os.makedirs(work)
     checks = {"flower": check_flower, "icm": check_icm, "frames": check_frames,
               "film": check_film, "interrupt": check_interrupt, "inside": check_inside,
-              "mesh": check_mesh}
+              "camera": check_camera, "mesh": check_mesh}
     if check not in checks:
         sys.exit(f"unknown check {check!r}")
     checks[check](ictk, work, data)
