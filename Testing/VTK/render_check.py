@@ -4,7 +4,9 @@
 what it prints and writes (the FRep model pictures are ictk_cli_check.py's `render`).
 
 Usage: render_check.py --ictk PATH --work DIR --data DATA CHECK
-  flower | icm | frames | film | interrupt | inside | camera | mesh
+  flower | icm | frames | film | interrupt | inside | camera | baselines | mesh
+baselines compares pictures with Testing/Data/Baseline/Render*.png; with the environment variable
+ICTK_REGENERATE_BASELINES=1 it writes them instead.
 mesh needs an X display (run it under Testing/ParaView/run_checked.py --xvfb).
 """
 import math
@@ -199,6 +201,70 @@ def check_camera(ictk, work, data):
     no_leftovers(work)
 
 
+# The pictures compared with baselines: small, one per kind of scene.
+BASELINES = {
+    "RenderWalnut.png": ["walnut", "--size", "64,48"],
+    "RenderWalnutMaterials.png": ["walnut", "--size", "64,48", "--colour-by", "material",
+                                  "--colour-map", "rainbow", "--view", "90,0"],
+    "RenderFlower.png": ["@DATA@/Models/flower/flower.json", "--size", "64,48", "--view", "-70,25"],
+    "RenderDisk.png": ["@DATA@/Models/icm/ch5_1_disk_rectangle.icm", "--size", "64,48",
+                       "--time", "3"],
+}
+# A pixel differs when a channel differs by more than this (of 255); a picture passes when at
+# most TOLERANCE_PIXELS of its pixels differ (rounding of shading, libm, silhouettes).
+TOLERANCE_CHANNEL = 8
+TOLERANCE_PIXELS = 0.01
+
+
+def write_png(path, w, h, pixels):
+    import vtk
+    image = vtk.vtkImageData()
+    image.SetDimensions(w, h, 1)
+    a = vtk.vtkUnsignedCharArray()
+    a.SetNumberOfComponents(4)
+    a.SetNumberOfTuples(w * h)
+    for i, q in enumerate(pixels):
+        for c in range(4):
+            a.SetComponent(i, c, q[c])
+    image.GetPointData().SetScalars(a)
+    writer = vtk.vtkPNGWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(image)
+    writer.Write()
+
+
+def check_baselines(ictk, work, data):
+    """Pictures against their baselines with a tolerance; the difference image is written on
+    failure (white where equal, the difference amplified eight times elsewhere)."""
+    folder = os.path.join(data, "..", "Testing", "Data", "Baseline")
+    regenerate = os.environ.get("ICTK_REGENERATE_BASELINES") == "1"
+    failed = []
+    for name, args in BASELINES.items():
+        out = os.path.join(work, name)
+        run(ictk, ["render"] + [a.replace("@DATA@", data) for a in args] + ["-o", out])
+        baseline = os.path.join(folder, name)
+        if regenerate:
+            shutil.copyfile(out, baseline)
+            print(f"wrote {baseline}")
+            continue
+        w, h, got = read_png(out)
+        bw, bh, want = read_png(baseline)
+        if (w, h) != (bw, bh):
+            failed.append(f"{name}: {w} x {h}, the baseline is {bw} x {bh}")
+            continue
+        diff = [max(abs(a - b) for a, b in zip(p, q)) for p, q in zip(got, want)]
+        bad = sum(1 for d in diff if d > TOLERANCE_CHANNEL)
+        print(f"{name}: {bad} of {w * h} pixels differ by more than {TOLERANCE_CHANNEL}")
+        if bad > TOLERANCE_PIXELS * w * h:
+            image = os.path.join(work, name.replace(".png", "-difference.png"))
+            write_png(image, w, h, [(255, 255, 255, 255) if d == 0 else
+                                    (255, max(0, 255 - 8 * d), max(0, 255 - 8 * d), 255)
+                                    for d in diff])
+            failed.append(f"{name}: {bad} pixels differ (difference image: {image})")
+    if failed:
+        sys.exit("FAIL: " + "; ".join(failed))
+
+
 def read_depth(path):
     import vtk
     r = vtk.vtkXMLImageDataReader()
@@ -257,7 +323,7 @@ def main():
     os.makedirs(work)
     checks = {"flower": check_flower, "icm": check_icm, "frames": check_frames,
               "film": check_film, "interrupt": check_interrupt, "inside": check_inside,
-              "camera": check_camera, "mesh": check_mesh}
+              "camera": check_camera, "baselines": check_baselines, "mesh": check_mesh}
     if check not in checks:
         sys.exit(f"unknown check {check!r}")
     checks[check](ictk, work, data)
