@@ -105,6 +105,9 @@ public:
       "Output picture (.png); with --frames a pattern (frames/%04d.png) or an .mp4 film");
     render->add_option(
       "--size", this->Size, "Image size W,H in pixels, 1..4096 each (default 800,600)");
+    render->add_option("--bounds", this->Bounds,
+      "x0,x1,y0,y1,z0,z1: the box an FRep model is drawn in, which cuts it open where it is "
+      "smaller than the model (default: the model's bounds)");
     this->ViewOption = render->add_option("--view", this->View,
       "Camera: azimuth,elevation[,distance]: degrees about +z from +x, degrees above the "
       "xy-plane, distance from the centre of the model's box (default 30,20 and 2.5 times the "
@@ -154,6 +157,11 @@ public:
     this->CheckOptions();
     const bool complexFile = IsComplexInput(this->Model);
     const bool dynamic = HasExtension(this->Model, ".icm");
+    if ((complexFile || dynamic) && !this->Bounds.empty())
+    {
+      throw UserError("--bounds: the box to draw in is for FRep models; a complex's cells have "
+                      "their own boxes");
+    }
     if (complexFile && (this->TimeOption->count() > 0 || !this->Frames.empty()))
     {
       throw UserError("render: '" + this->Model +
@@ -543,7 +551,11 @@ private:
         throw UserError(
           "--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
       }
-      const ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
+      ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
+      if (!this->Bounds.empty())
+      {
+        ParseBounds(this->Bounds, model.Lo, model.Hi);
+      }
       name = model.Name;
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
       ProgressBar bar("rendering " + model.Name, true);
@@ -646,7 +658,11 @@ private:
         throw UserError(
           "--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
       }
-      const ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
+      ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
+      if (!this->Bounds.empty())
+      {
+        ParseBounds(this->Bounds, model.Lo, model.Hi);
+      }
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
       for (k = 0; k < times.size(); ++k)
       {
@@ -737,6 +753,7 @@ private:
   double PointRadius = 0;
   double FeatureSize = 0;
   std::string Mode = "raycast";
+  std::string Bounds;
   std::string CameraFile;
   CLI::Option* ViewOption = nullptr;
   CLI::Option* ProjectionOption = nullptr;

@@ -431,3 +431,24 @@ TEST(RenderCamera, LookAtIsTheOrbitGivenItsValues)
     Camera::lookAt({ 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, Projection::Orthographic, 30, 0, 8, 8),
     std::invalid_argument);
 }
+
+TEST(RenderRayCast, ACutByTheBoxIsLitByItsFace)
+{
+  // A ball larger than the cube, seen from +x: the face x = 1 cuts it, and every pixel of the
+  // cut faces the eye, so it gets the full light whatever the field's gradient does there.
+  const Box3 cube{ { -1, -1, -1 }, { 1, 1, 1 } };
+  const Expr ball = Expr(1.44) - (square(Expr::x()) + square(Expr::y()) + square(Expr::z()));
+  const Camera front = Camera::orbit(cube, View{ 0, 0, 3 }, Projection::Orthographic, 16, 16);
+  const RayCastResult cut = rayCast(Tape::compile(ball), cube, front);
+  ASSERT_GT(cut.cutPixels, 20);
+  int flat = 0;
+  for (std::size_t p = 0; p < cut.depth.size(); ++p)
+  {
+    if (cut.depth[p] == 2.0) // the face x = 1, from the image plane at x = 3
+    {
+      ++flat;
+      EXPECT_EQ(cut.colour[4 * p], std::lround(255 * NeutralGrey));
+    }
+  }
+  EXPECT_EQ(flat, cut.cutPixels);
+}

@@ -191,6 +191,7 @@ struct Ray
   Point3 direction{};
   double length = 1; // |direction|: the distance along the ray per unit of depth s
   double start = 0;  // the depth where the ray enters the box (or the near end)
+  int face = -1;     // the axis of the box face it enters by; -1: the near end
   double lastS = std::numeric_limits<double>::quiet_NaN();
   double lastF = 0;
   Point3 at(double s) const
@@ -512,7 +513,11 @@ private:
       {
         std::swap(e0, e1);
       }
-      entry = std::max(entry, e0);
+      if (e0 >= entry)
+      {
+        entry = e0; // on a tie with the near end (which the box's corners give) too
+        ray.face = a;
+      }
       exit = std::min(exit, e1);
     }
     if (limited_)
@@ -644,7 +649,18 @@ private:
   {
     done(ws, ray.i, ray.j) = 1;
     const Paint paint = ws.painter && !unresolved ? ws.painter->at(ray.at(inside)) : Paint{};
-    const double light = headlight(stage.gradient(ray.at(s)), ray.direction, ray.length);
+    // A solid cut by its box shows the cut flat, lit by the face's normal (its gradient there
+    // belongs to no surface: on a tie of a min or max it even flips from pixel to pixel).
+    frep::Point3 normal{ 0, 0, 0 };
+    if (!unresolved && s == ray.start && ray.face >= 0)
+    {
+      normal[static_cast<std::size_t>(ray.face)] = 1;
+    }
+    else
+    {
+      normal = stage.gradient(ray.at(s));
+    }
+    const double light = headlight(normal, ray.direction, ray.length);
     if (!canvas_.put(canvas_.index(ray.i, ray.j), s * ray.length, light, paint, solid_.owner))
     {
       return false;
