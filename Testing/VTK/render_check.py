@@ -4,7 +4,7 @@
 what it prints and writes (the FRep model pictures are ictk_cli_check.py's `render`).
 
 Usage: render_check.py --ictk PATH --work DIR --data DATA CHECK
-  flower | icm | frames | film | interrupt | inside | camera | baselines | mesh
+  flower | icm | frames | film | interrupt | inside | camera | baselines | pictures | mesh
 baselines compares pictures with Testing/Data/Baseline/Render*.png; with the environment variable
 ICTK_REGENERATE_BASELINES=1 it writes them instead.
 mesh needs an X display (run it under Testing/ParaView/run_checked.py --xvfb).
@@ -265,6 +265,29 @@ def check_baselines(ictk, work, data):
         sys.exit("FAIL: " + "; ".join(failed))
 
 
+def check_pictures(ictk, work, data):
+    """The README shows, under its pictures, the commands Scripts/pictures makes them with, and
+    every picture is there; each command runs (at a tenth of the size, into the work folder)."""
+    root = os.path.join(data, "..")
+    with open(os.path.join(root, "Scripts", "pictures")) as f:
+        lines = [l.split() for l in f if l.startswith("picture ")]
+    with open(os.path.join(root, "README.md")) as f:
+        readme = f.read()
+    if len(lines) < 6:
+        sys.exit(f"FAIL: {len(lines)} pictures in Scripts/pictures")
+    for name, *args in (l[1:] for l in lines):
+        command = f"ictk render {' '.join(args)} -o docs/images/{name}"
+        if command not in readme:
+            sys.exit(f"FAIL: the README does not show {command!r}")
+        if f"](docs/images/{name})" not in readme or not os.path.exists(
+                os.path.join(root, "docs", "images", name)):
+            sys.exit(f"FAIL: docs/images/{name} is not in the README or not in docs/images")
+        small = [a if a != "240,180" else "24,18" for a in args]
+        run(ictk, ["render"] + [os.path.join(root, a) if a.startswith("Data/") else a
+                                for a in small] + ["-o", os.path.join(work, name)])
+    no_leftovers(work)
+
+
 def read_depth(path):
     import vtk
     r = vtk.vtkXMLImageDataReader()
@@ -323,7 +346,8 @@ def main():
     os.makedirs(work)
     checks = {"flower": check_flower, "icm": check_icm, "frames": check_frames,
               "film": check_film, "interrupt": check_interrupt, "inside": check_inside,
-              "camera": check_camera, "baselines": check_baselines, "mesh": check_mesh}
+              "camera": check_camera, "baselines": check_baselines,
+              "pictures": check_pictures, "mesh": check_mesh}
     if check not in checks:
         sys.exit(f"unknown check {check!r}")
     checks[check](ictk, work, data)
