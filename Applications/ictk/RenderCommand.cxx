@@ -423,6 +423,21 @@ private:
     }
   }
 
+  /// The FRep model to ray cast, in its box or --bounds'.
+  ResolvedModel ModelToDraw() const
+  {
+    if (this->Mode == "mesh")
+    {
+      throw UserError("--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
+    }
+    ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
+    if (!this->Bounds.empty())
+    {
+      ParseBounds(this->Bounds, model.Lo, model.Hi);
+    }
+    return model;
+  }
+
   Drawn DrawModel(const ResolvedModel& model, const render::Camera& camera, double time,
     const Progress& progress) const
   {
@@ -546,16 +561,7 @@ private:
     }
     else
     {
-      if (this->Mode == "mesh")
-      {
-        throw UserError(
-          "--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
-      }
-      ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
-      if (!this->Bounds.empty())
-      {
-        ParseBounds(this->Bounds, model.Lo, model.Hi);
-      }
+      const ResolvedModel model = this->ModelToDraw();
       name = model.Name;
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
       ProgressBar bar("rendering " + model.Name, true);
@@ -653,16 +659,7 @@ private:
     }
     else
     {
-      if (this->Mode == "mesh")
-      {
-        throw UserError(
-          "--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
-      }
-      ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
-      if (!this->Bounds.empty())
-      {
-        ParseBounds(this->Bounds, model.Lo, model.Hi);
-      }
+      const ResolvedModel model = this->ModelToDraw();
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
       for (k = 0; k < times.size(); ++k)
       {
