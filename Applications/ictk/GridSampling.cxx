@@ -154,21 +154,7 @@ GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
   std::array<double, 3>& hi = plan.Model.Hi;
   if (!o.Bounds.empty())
   {
-    const std::vector<double> b = ParseNumbers(
-      o.Bounds, "--bounds", { "x0", "x1", "y0", "y1", "z0", "z1" }, 6, 6, "x0,x1,y0,y1,z0,z1");
-    static const char* axes[] = { "x", "y", "z" };
-    for (int a = 0; a < 3; ++a)
-    {
-      lo[a] = b[2 * a];
-      hi[a] = b[2 * a + 1];
-      if (lo[a] > hi[a])
-      {
-        std::ostringstream os;
-        os << "--bounds: " << axes[a] << "0 > " << axes[a] << "1 (" << lo[a] << " > " << hi[a]
-           << ")";
-        throw UserError(os.str());
-      }
-    }
+    ParseBounds(o.Bounds, lo, hi);
   }
   std::array<std::int64_t, 3>& dims = plan.Dims;
   if (!o.Dims.empty())

@@ -10,6 +10,7 @@
 #include "Lang/Diagnostics.h"
 #include "ictkComplexSource.h"
 
+#include <fstream>
 #include <stdexcept>
 
 namespace ictk::cli
@@ -103,6 +104,25 @@ complex::Complex LoadComplex(const std::string& path)
   k.name = model.name;
   k.addCell(complex::frepCell(model.name, {}, { model.model.geometry().function() }, box));
   return k;
+}
+
+lang::ParseError AsParseError(const engine::ModelError& e)
+{
+  lang::Diagnostic d;
+  d.where.file = e.file;
+  d.where.line = e.pos.line;
+  d.where.column = e.pos.column;
+  d.message = e.message;
+  std::ifstream in(e.file);
+  std::string line;
+  for (int i = 0; i < e.pos.line && std::getline(in, line); ++i)
+  {
+  }
+  if (e.pos.line > 0 && in)
+  {
+    d.sourceLine = line;
+  }
+  return lang::ParseError({ d });
 }
 
 } // namespace ictk::cli

@@ -5,8 +5,10 @@
 // diagnostics are a ModelFileError (printed as they are: file:line:col, source line, caret).
 
 #include "Complex/Complex.h"
+#include "Engine/DynamicModel.h"
 #include "FRep/Hypervolume.h"
 #include "FRep/ModelRegistry.h"
+#include "Lang/Diagnostics.h"
 #include "Lang/ModelFile.h"
 
 #include <array>
@@ -42,5 +44,10 @@ bool IsComplexOutput(const std::string& path);
 /// A .json complex (with VTK's readers for its cells' files), or a .hf / .xml model as a complex
 /// of one 3D cell.
 complex::Complex LoadComplex(const std::string& path);
+
+/// The engine's errors (a .icm model that reads but does not build) in the front ends' form
+/// (file:line:col, the source line and a caret), so that they report like a model that does
+/// not read.
+lang::ParseError AsParseError(const engine::ModelError& e);
 
 } // namespace ictk::cli

@@ -188,6 +188,24 @@ std::array<std::int64_t, 3> ParseDims(const std::string& text)
   return { v[0], v[1], v[2] };
 }
 
+void ParseBounds(const std::string& text, std::array<double, 3>& lo, std::array<double, 3>& hi)
+{
+  const std::vector<double> b = ParseNumbers(
+    text, "--bounds", { "x0", "x1", "y0", "y1", "z0", "z1" }, 6, 6, "x0,x1,y0,y1,z0,z1");
+  static const char* axes[] = { "x", "y", "z" };
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = b[2 * a];
+    hi[a] = b[2 * a + 1];
+    if (lo[a] > hi[a])
+    {
+      std::ostringstream os;
+      os << "--bounds: " << axes[a] << "0 > " << axes[a] << "1 (" << lo[a] << " > " << hi[a] << ")";
+      throw UserError(os.str());
+    }
+  }
+}
+
 std::vector<double> ParseFrames(const std::string& spec, const std::string& option)
 {
   const std::vector<std::string> fields = Split(spec, ':');

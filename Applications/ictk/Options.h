@@ -63,6 +63,8 @@ std::vector<double> ParseParameters(const std::string& text);
 /// caller); `expected` spells the form for the count's message (e.g. "NX,NY,NZ").
 std::vector<std::int64_t> ParseIntegers(const std::string& text, const std::string& option,
   const std::vector<std::string>& names, const std::string& expected);
+/// --bounds: x0,x1,y0,y1,z0,z1 into lo and hi (a UserError for x0 > x1 and the like).
+void ParseBounds(const std::string& text, std::array<double, 3>& lo, std::array<double, 3>& hi);
 /// --dims: NX,NY,NZ, integers (their range is checked by the caller).
 std::array<std::int64_t, 3> ParseDims(const std::string& text);
 

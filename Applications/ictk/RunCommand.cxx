@@ -5,6 +5,7 @@
 // dynamic complex source written by the time series writer (Engine/FrameSequence.h is their one
 // frame loop); this file adds the trace, the progress display, Ctrl-C and the summary.
 #include "Command.h"
+#include "Models.h"
 #include "Options.h"
 #include "ProgressDisplay.h"
 #include "VtkMessages.h"
@@ -61,27 +62,6 @@ struct RunModelOptions
   bool Json = false;
   int Threads = 0;
 };
-
-/// The engine's errors in the front ends' form (file:line:col, the source line and a caret), so
-/// that a model that reads but does not build reports like one that does not read.
-lang::ParseError AsParseError(const engine::ModelError& e)
-{
-  lang::Diagnostic d;
-  d.where.file = e.file;
-  d.where.line = e.pos.line;
-  d.where.column = e.pos.column;
-  d.message = e.message;
-  std::ifstream in(e.file);
-  std::string line;
-  for (int i = 0; i < e.pos.line && std::getline(in, line); ++i)
-  {
-  }
-  if (e.pos.line > 0 && in)
-  {
-    d.sourceLine = line;
-  }
-  return lang::ParseError({ d });
-}
 
 std::string TraceLine(const engine::FrameRecord& r)
 {

@@ -34,6 +34,11 @@ std::vector<discretize::PointArray>& CellMesh::pointData()
   }
 }
 
+const std::vector<discretize::PointArray>& CellMesh::pointData() const
+{
+  return const_cast<CellMesh*>(this)->pointData();
+}
+
 const CellMesh& ComplexMesh::of(CellId id) const
 {
   auto it = std::lower_bound(

@@ -42,6 +42,7 @@ struct CellMesh
   /// Points of the discretisation (whichever member holds them).
   const std::vector<Point3>& vertices() const;
   std::vector<discretize::PointArray>& pointData();
+  const std::vector<discretize::PointArray>& pointData() const;
 };
 
 struct ComplexMesh

@@ -70,6 +70,63 @@ Camera Camera::orbit(
   return c;
 }
 
+Camera Camera::lookAt(const Point3& position, const Point3& focalPoint, const Point3& up,
+  Projection projection, double viewAngle, double parallelScale, int width, int height)
+{
+  if (width < 1 || width > MaxImageSize || height < 1 || height > MaxImageSize)
+  {
+    throw std::invalid_argument("image size " + std::to_string(width) + " x " +
+      std::to_string(height) + " is outside 1.." + std::to_string(MaxImageSize) + " per side");
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(position[a]) || !std::isfinite(focalPoint[a]) || !std::isfinite(up[a]))
+    {
+      throw std::invalid_argument("the camera's position, focal point and up must be finite");
+    }
+  }
+  const Point3 toFocus = sub(focalPoint, position);
+  if (!(norm(toFocus) > 0))
+  {
+    throw std::invalid_argument("the camera's position is its focal point");
+  }
+  Camera c;
+  c.width_ = width;
+  c.height_ = height;
+  c.projection_ = projection;
+  c.eye_ = position;
+  c.forward_ = unit(toFocus);
+  const Point3 side = cross(c.forward_, up);
+  if (!(norm(side) > 1e-9 * norm(up)) || !(norm(up) > 0))
+  {
+    throw std::invalid_argument("the camera's up is zero or along its view direction");
+  }
+  c.right_ = unit(side);
+  c.up_ = cross(c.right_, c.forward_);
+  if (projection == Projection::Perspective)
+  {
+    if (!(viewAngle > 0 && viewAngle < 180))
+    {
+      throw std::invalid_argument("the view angle must be between 0 and 180 degrees");
+    }
+    c.pixelSize_ = 2 * std::tan(0.5 * viewAngle * Pi / 180) / height;
+  }
+  else
+  {
+    if (!(parallelScale > 0) || !std::isfinite(parallelScale))
+    {
+      throw std::invalid_argument("the parallel scale must be positive and finite");
+    }
+    c.pixelSize_ = 2 * parallelScale / height;
+  }
+  return c;
+}
+
+double Camera::viewAngle() const
+{
+  return 2 * std::atan(0.5 * pixelSize_ * height_) * 180 / Pi;
+}
+
 Point3 Camera::origin(double u, double v) const
 {
   if (projection_ == Projection::Perspective)

@@ -56,6 +56,16 @@ public:
   static Camera orbit(
     const frep::Box3& box, const View& view, Projection projection, int width, int height);
 
+  /// A camera at `position` looking at `focalPoint`, `up` pointing up on the picture (made
+  /// orthogonal to the view direction), VTK's conventions: perspective with a vertical
+  /// `viewAngle` in degrees (0 < viewAngle < 180), or orthographic showing a height of twice
+  /// `parallelScale`. Throws std::invalid_argument on a size outside 1..MaxImageSize, values
+  /// that are not finite, a position at the focal point, an up along the view direction, or an
+  /// angle or scale out of range.
+  static Camera lookAt(const frep::Point3& position, const frep::Point3& focalPoint,
+    const frep::Point3& up, Projection projection, double viewAngle, double parallelScale,
+    int width, int height);
+
   int width() const { return width_; }
   int height() const { return height_; }
   Projection projection() const { return projection_; }
@@ -63,6 +73,8 @@ public:
   const frep::Point3& forward() const { return forward_; }
   const frep::Point3& right() const { return right_; }
   const frep::Point3& up() const { return up_; }
+  /// The vertical field of view of a perspective camera, in degrees.
+  double viewAngle() const;
   /// The side of a pixel on the image plane: at depth s = 1 (perspective) or in model units
   /// (orthographic). At depth s a perspective pixel covers pixelSize() * s.
   double pixelSize() const { return pixelSize_; }

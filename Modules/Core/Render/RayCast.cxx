@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Render/RayCast.h"
 
+#include "Render/RayCaster.h"
+
 #include "FRep/Evaluators.h"
 #include "FRep/RootFinding.h"
 #include "FRep/Threads.h"
@@ -28,10 +30,6 @@ using frep::TapePtr;
 namespace
 {
 
-constexpr double Ambient = 0.25;
-constexpr double Diffuse = 0.75;
-constexpr double NeutralGrey = 0.8;
-
 /// A rectangle of pixels [i0, i1) x [j0, j1).
 struct Rect
 {
@@ -39,70 +37,150 @@ struct Rect
   bool single() const { return i1 - i0 == 1 && j1 - j0 == 1; }
 };
 
-/// The evaluators of one tape: the full one, or one simplified for a piece of the view. The
-/// interval evaluator is borrowed from the parent while the tape is the parent's; the point and
-/// gradient evaluators are made when first needed (only pixels evaluate points).
-class Stage
+/// The evaluators of one tape at the render's time: the full one, or one simplified for a piece
+/// of the view. The point and gradient evaluators are made when first needed (only pixels
+/// evaluate points).
+class TapeStage final : public detail::Stage
 {
 public:
-  Stage(TapePtr tape, const std::vector<double>& parameters, IntervalEvaluator* interval)
+  TapeStage(TapePtr tape, const std::vector<double>& parameters, double time)
     : tape_(std::move(tape))
     , parameters_(parameters)
-    , interval_(interval)
+    , time_(time)
+    , interval_(tape_, parameters_)
   {
-    if (!interval_)
-    {
-      ownInterval_.emplace(tape_, parameters_);
-      interval_ = &*ownInterval_;
-    }
   }
-  Stage(const Stage&) = delete;
-  Stage& operator=(const Stage&) = delete;
 
-  const TapePtr& tape() const { return tape_; }
-  IntervalEvaluator& interval() { return *interval_; }
-  frep::PointEvaluator& point()
+  Interval bound(const Box3& box) override
   {
-    if (!point_)
+    frep::Region region;
+    for (int a = 0; a < 3; ++a)
     {
-      point_.emplace(tape_, parameters_);
+      region.axes[a] = { box.lo[a], box.hi[a] };
     }
-    return *point_;
-  }
-  frep::GradientEvaluator& gradient()
-  {
-    if (!gradient_)
-    {
-      gradient_.emplace(tape_, parameters_);
-    }
-    return *gradient_;
+    region.axes[3] = { time_, time_ };
+    return interval_.eval(region);
   }
 
   /// The tape simplified by the choices of the interval evaluator's last eval, or null when
   /// nothing would be cut.
-  TapePtr narrowed() const
+  std::unique_ptr<detail::Stage> narrowed() override
   {
     if (tape_->choiceCount() == 0)
     {
       return nullptr;
     }
-    const auto& choices = interval_->choices();
+    const auto& choices = interval_.choices();
     if (std::all_of(
           choices.begin(), choices.end(), [](frep::Choice c) { return c == frep::Choice::Both; }))
     {
       return nullptr;
     }
-    TapePtr pruned = interval_->simplified();
-    return pruned == tape_ ? nullptr : pruned;
+    TapePtr pruned = interval_.simplified();
+    if (pruned == tape_)
+    {
+      return nullptr;
+    }
+    return std::make_unique<TapeStage>(std::move(pruned), parameters_, time_);
+  }
+
+  double value(const Point3& p) override
+  {
+    if (!point_)
+    {
+      point_.emplace(tape_, parameters_);
+    }
+    return point_->eval(p[0], p[1], p[2], time_);
+  }
+
+  Point3 gradient(const Point3& p) override
+  {
+    if (!gradient_)
+    {
+      gradient_.emplace(tape_, parameters_);
+    }
+    const frep::ValueGradient g = gradient_->eval(p[0], p[1], p[2], time_);
+    return { g.gradient[0], g.gradient[1], g.gradient[2] };
   }
 
 private:
   TapePtr tape_;
   const std::vector<double>& parameters_;
-  IntervalEvaluator* interval_;
-  std::optional<IntervalEvaluator> ownInterval_;
+  double time_;
+  IntervalEvaluator interval_;
   std::optional<frep::PointEvaluator> point_;
   std::optional<frep::GradientEvaluator> gradient_;
+};
+
+/// A field's evaluator as a stage.
+class FieldStage final : public detail::Stage
+{
+public:
+  explicit FieldStage(std::unique_ptr<frep::FieldEvaluator> evaluator)
+    : evaluator_(std::move(evaluator))
+  {
+  }
+  Interval bound(const Box3& box) override
+  {
+    last_ = box;
+    return evaluator_->bound(box);
+  }
+  std::unique_ptr<detail::Stage> narrowed() override
+  {
+    std::unique_ptr<frep::FieldEvaluator> n = evaluator_->narrowed(last_);
+    return n ? std::make_unique<FieldStage>(std::move(n)) : nullptr;
+  }
+  double value(const Point3& p) override { return evaluator_->value(p); }
+  Point3 gradient(const Point3& p) override
+  {
+    Point3 g{};
+    evaluator_->gradient(p, g);
+    return g;
+  }
+
+private:
+  std::unique_ptr<frep::FieldEvaluator> evaluator_;
+  Box3 last_{};
+};
+
+/// A model's attribute at the first point found inside: a colour (3 or 4 components in [0, 1],
+/// the last ignored) or a scalar.
+class AttributePainter final : public detail::Painter
+{
+public:
+  AttributePainter(const frep::Hypervolume& model, const std::vector<double>& parameters,
+    double time, std::size_t offset, bool scalar)
+    : evaluator_(model, parameters)
+    , values_(model.attributeComponentCount())
+    , time_(time)
+    , offset_(offset)
+    , scalar_(scalar)
+  {
+  }
+  Paint at(const Point3& p) override
+  {
+    double value = 0;
+    evaluator_.eval({ p[0], p[1], p[2], time_ }, value, values_.data());
+    Paint paint;
+    if (scalar_)
+    {
+      paint.scalar = values_[offset_];
+      return paint;
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      const double x = values_[offset_ + c];
+      paint.rgb[c] = std::isfinite(x) ? std::clamp(x, 0.0, 1.0) : NeutralGrey;
+    }
+    return paint;
+  }
+
+private:
+  frep::HypervolumeEvaluator evaluator_;
+  std::vector<double> values_;
+  double time_;
+  std::size_t offset_;
+  bool scalar_;
 };
 
 /// One pixel's ray, with the last value of f computed on it (neighbouring leaves share an end).
@@ -113,6 +191,7 @@ struct Ray
   Point3 direction{};
   double length = 1; // |direction|: the distance along the ray per unit of depth s
   double start = 0;  // the depth where the ray enters the box (or the near end)
+  int face = -1;     // the axis of the box face it enters by; -1: the near end
   double lastS = std::numeric_limits<double>::quiet_NaN();
   double lastF = 0;
   Point3 at(double s) const
@@ -125,39 +204,35 @@ struct Ray
 /// What a thread keeps between tiles.
 struct Workspace
 {
-  Workspace(
-    const TapePtr& tape, const std::vector<double>& parameters, const frep::Hypervolume* model)
-    : interval(tape, parameters)
+  explicit Workspace(const detail::Solid& solid)
+    : root(solid.stage())
   {
-    if (model)
+    if (solid.painter)
     {
-      attributes.emplace(*model, parameters);
-      attributeValues.resize(model->attributeComponentCount());
+      painter = solid.painter();
     }
   }
-  IntervalEvaluator interval; // of the full tape: the root stage of every tile borrows it
-  std::optional<frep::HypervolumeEvaluator> attributes;
-  std::vector<double> attributeValues;
+  std::unique_ptr<detail::Stage> root; // the full evaluation: every tile starts with it
+  std::unique_ptr<detail::Painter> painter;
   std::vector<std::uint8_t> done; // the current tile's pixels that found their surface
   /// Per pixel of the tile: the depth of the first piece that was left unresolved (NaN: none).
   std::vector<double> unresolvedAt;
-  Stage* root = nullptr; // the full tape's stage of the current tile
   Rect tile{ 0, 0, 0, 0 };
-  std::int64_t intervals = 0, points = 0, covered = 0, unresolved = 0, cut = 0;
+  detail::CastCounts counts;
 };
 
 class RayCaster
 {
 public:
-  RayCaster(const TapePtr& tape, const frep::Hypervolume* model, const Box3& box,
-    const Camera& camera, const RayCastOptions& options, RayCastResult& out)
-    : tape_(tape)
-    , model_(model)
-    , box_(box)
+  RayCaster(
+    Canvas& canvas, const detail::Solid& solid, const Camera& camera, const RayCastOptions& options)
+    : canvas_(canvas)
+    , solid_(solid)
+    , box_(solid.box)
     , camera_(camera)
     , options_(options)
-    , out_(out)
   {
+    const Box3& box = solid.box;
     const double halfDiagonal = 0.5 * frep::norm(frep::sub(box.hi, box.lo));
     tolerance_ = options.depthTolerance > 0 ? options.depthTolerance : 1e-6 * halfDiagonal;
     // The bounding boxes of the pieces are widened by this much, so that rounding in their
@@ -176,38 +251,19 @@ public:
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
-    near_ =
-      std::max(lo, camera.projection() == Projection::Perspective ? 1e-9 * halfDiagonal : 0.0);
+    const double nearest =
+      camera.projection() == Projection::Perspective ? 1e-9 * halfDiagonal : 0.0;
+    near_ = std::max(lo, nearest);
+    eyeInBox_ = lo <= nearest;
     far_ = hi;
-    if (model_)
-    {
-      std::size_t offset = 0;
-      for (const frep::Attribute& a : model_->attributes())
-      {
-        if ((a.name == "colour" || a.name == "color") &&
-          (a.components.size() == 3 || a.components.size() == 4))
-        {
-          colourOffset_ = static_cast<std::ptrdiff_t>(offset);
-          break;
-        }
-        offset += a.components.size();
-      }
-    }
+    // A canvas that already holds surfaces limits the rays (the common z-buffer).
+    limited_ = std::any_of(
+      canvas.depth.begin(), canvas.depth.end(), [](double d) { return std::isfinite(d); });
   }
 
-  void run()
+  detail::CastCounts run()
   {
     const int w = camera_.width(), h = camera_.height();
-    out_.width = w;
-    out_.height = h;
-    const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-    out_.colour.assign(4 * pixels, 0);
-    for (std::size_t p = 0; p < pixels; ++p)
-    {
-      out_.colour[4 * p] = out_.colour[4 * p + 1] = out_.colour[4 * p + 2] = 255;
-    }
-    out_.depth.assign(pixels, std::numeric_limits<double>::infinity());
-
     const int edge = options_.tileSize;
     const int tilesX = (w + edge - 1) / edge, tilesY = (h + edge - 1) / edge;
     const std::int64_t tileCount = static_cast<std::int64_t>(tilesX) * tilesY;
@@ -220,7 +276,7 @@ public:
       auto& slot = workspaces.local();
       if (!slot)
       {
-        slot.emplace(tape_, options_.parameters, model_);
+        slot.emplace(solid_);
       }
       for (std::int64_t t = range.begin(); t != range.end(); ++t)
       {
@@ -238,17 +294,20 @@ public:
     const tbb::blocked_range<std::int64_t> all(0, tileCount, 1);
     runOnThreads(options_.threads, [&] { tbb::parallel_for(all, body); });
     progress.report(1);
+    detail::CastCounts counts;
     for (const auto& slot : workspaces)
     {
       if (slot)
       {
-        out_.intervalEvaluations += slot->intervals;
-        out_.pointEvaluations += slot->points;
-        out_.coveredPixels += slot->covered;
-        out_.unresolvedPixels += slot->unresolved;
-        out_.cutPixels += slot->cut;
+        counts.intervals += slot->counts.intervals;
+        counts.points += slot->counts.points;
+        counts.covered += slot->counts.covered;
+        counts.unresolved += slot->counts.unresolved;
+        counts.cut += slot->counts.cut;
+        counts.eyeInside += slot->counts.eyeInside;
       }
     }
+    return counts;
   }
 
 private:
@@ -262,9 +321,7 @@ private:
     {
       return; // the box is behind the camera
     }
-    Stage root(tape_, options_.parameters, &ws.interval);
-    ws.root = &root;
-    node(ws, root, tile, near_, far_);
+    node(ws, *ws.root, tile, near_, far_);
     // Rays that left a piece unresolved and found nothing behind it within a leaf.
     for (int j = tile.j0; j < tile.j1; ++j)
     {
@@ -274,11 +331,17 @@ private:
         if (!done(ws, i, j) && !std::isnan(u))
         {
           const Ray ray = rayOf(i, j);
-          hit(ws, root, ray, u, u, true);
+          // The surface the canvas holds within a leaf behind the piece is the one found there
+          // (the ray was cut at its depth, so the search could not go on to it).
+          const double held = canvas_.depth[canvas_.index(i, j)];
+          if (held - u * ray.length <= footprint(u))
+          {
+            continue;
+          }
+          hit(ws, *ws.root, ray, u, u, true);
         }
       }
     }
-    ws.root = nullptr;
   }
 
   Ray rayOf(int i, int j) const
@@ -304,9 +367,12 @@ private:
   }
 
   /// The smallest rectangle that holds the pixels of `r` still to be found; false if none.
-  bool remaining(Workspace& ws, Rect& r) const
+  /// `limit`: a depth s beyond which none of them needs searching (the canvas's depths, which
+  /// are distances along rays of |direction| >= 1, bound their s from above).
+  bool remaining(Workspace& ws, Rect& r, double& limit) const
   {
     Rect p{ r.i1, r.j1, r.i0, r.j0 };
+    limit = limited_ ? 0 : std::numeric_limits<double>::infinity();
     for (int j = r.j0; j < r.j1; ++j)
     {
       for (int i = r.i0; i < r.i1; ++i)
@@ -317,6 +383,10 @@ private:
           p.j0 = std::min(p.j0, j);
           p.i1 = std::max(p.i1, i + 1);
           p.j1 = std::max(p.j1, j + 1);
+          if (limited_)
+          {
+            limit = std::max(limit, searched(canvas_.depth[canvas_.index(i, j)]));
+          }
         }
       }
     }
@@ -328,6 +398,12 @@ private:
     return true;
   }
 
+  /// How far a ray is searched when the canvas holds a surface at distance `held` along it: a
+  /// leaf beyond, so that a solid whose surface lies at the held one (a patch on a solid's
+  /// boundary, a tube along it) is found by a sign change there rather than by halving the
+  /// pieces in front of it down to the depth tolerance; hits beyond `held` are not drawn.
+  double searched(double held) const { return held + footprint(held); }
+
   /// The lateral size of one pixel at depth s.
   double footprint(double s) const
   {
@@ -336,8 +412,8 @@ private:
   }
 
   /// An enclosure of f over the points between depths s0 and s1 on the rays of the pixel centres
-  /// of `r`, clipped to the model's box; false when that is empty or f < 0 there.
-  bool mayHold(Workspace& ws, Stage& stage, const Rect& r, double s0, double s1) const
+  /// of `r`, clipped to the solid's box; false when that is empty or f < 0 there.
+  bool mayHold(Workspace& ws, detail::Stage& stage, const Rect& r, double s0, double s1) const
   {
     const double u[2] = { camera_.u(r.i0), camera_.u(r.i1 - 1) };
     const double v[2] = { camera_.v(r.j0), camera_.v(r.j1 - 1) };
@@ -356,32 +432,32 @@ private:
     return mayHold(ws, stage, lo, hi);
   }
 
-  bool mayHold(Workspace& ws, Stage& stage, Point3 lo, Point3 hi) const
+  bool mayHold(Workspace& ws, detail::Stage& stage, Point3 lo, Point3 hi) const
   {
-    frep::Region region;
+    Box3 box;
     for (int a = 0; a < 3; ++a)
     {
-      lo[a] = std::max(lo[a] - pad_, box_.lo[a]);
-      hi[a] = std::min(hi[a] + pad_, box_.hi[a]);
-      if (!(lo[a] <= hi[a]))
+      box.lo[a] = std::max(lo[a] - pad_, box_.lo[a]);
+      box.hi[a] = std::min(hi[a] + pad_, box_.hi[a]);
+      if (!(box.lo[a] <= box.hi[a]))
       {
         return false;
       }
-      region.axes[a] = { lo[a], hi[a] };
     }
-    region.axes[3] = { options_.time, options_.time };
-    ++ws.intervals;
-    const Interval f = stage.interval().eval(region);
+    ++ws.counts.intervals;
+    const Interval f = stage.bound(box);
     return f.hi >= 0; // false for an empty interval too: NaN everywhere is outside
   }
 
   /// A rectangle of pixels between two depths (step 2 of the header's algorithm).
-  void node(Workspace& ws, Stage& stage, Rect r, double s0, double s1)
+  void node(Workspace& ws, detail::Stage& stage, Rect r, double s0, double s1)
   {
-    if (!remaining(ws, r))
+    double limit = 0;
+    if (!remaining(ws, r, limit) || !(s0 < limit))
     {
       return;
     }
+    s1 = std::min(s1, limit);
     if (r.single())
     {
       pixel(ws, stage, r.i0, r.j0, s0, s1);
@@ -391,12 +467,8 @@ private:
     {
       return;
     }
-    std::optional<Stage> narrow;
-    if (TapePtr pruned = stage.narrowed())
-    {
-      narrow.emplace(std::move(pruned), options_.parameters, nullptr);
-    }
-    Stage& next = narrow ? *narrow : stage;
+    std::unique_ptr<detail::Stage> narrow = stage.narrowed();
+    detail::Stage& next = narrow ? *narrow : stage;
     const int across = std::max(r.i1 - r.i0, r.j1 - r.j0);
     if (s1 - s0 > across * footprint(s1))
     {
@@ -418,8 +490,9 @@ private:
     }
   }
 
-  /// One pixel's ray between two depths, clipped to the model's box (step 3).
-  void pixel(Workspace& ws, Stage& stage, int i, int j, double s0, double s1)
+  /// One pixel's ray between two depths, clipped to the solid's box and to the depth the canvas
+  /// holds (step 3).
+  void pixel(Workspace& ws, detail::Stage& stage, int i, int j, double s0, double s1)
   {
     Ray ray = rayOf(i, j);
     // The ray's part inside the box: [entry, exit] of the depths near_..far_.
@@ -440,8 +513,16 @@ private:
       {
         std::swap(e0, e1);
       }
-      entry = std::max(entry, e0);
+      if (e0 >= entry)
+      {
+        entry = e0; // on a tie with the near end (which the box's corners give) too
+        ray.face = a;
+      }
       exit = std::min(exit, e1);
+    }
+    if (limited_)
+    {
+      exit = std::min(exit, searched(canvas_.depth[canvas_.index(i, j)]) / ray.length);
     }
     ray.start = entry;
     s0 = std::max(s0, entry);
@@ -453,7 +534,7 @@ private:
     segment(ws, stage, ray, s0, s1);
   }
 
-  bool segment(Workspace& ws, Stage& stage, Ray& ray, double a, double b)
+  bool segment(Workspace& ws, detail::Stage& stage, Ray& ray, double a, double b)
   {
     const double u = unresolvedAt(ws, ray.i, ray.j);
     if (!std::isnan(u) && (a - u) * ray.length > footprint(u))
@@ -484,22 +565,21 @@ private:
     return leaf(ws, stage, ray, a, b);
   }
 
-  double f(Workspace& ws, Stage& stage, Ray& ray, double s)
+  double f(Workspace& ws, detail::Stage& stage, Ray& ray, double s)
   {
     if (s == ray.lastS)
     {
       return ray.lastF;
     }
-    const Point3 p = ray.at(s);
-    ++ws.points;
-    const double value = stage.point().eval(p[0], p[1], p[2], options_.time);
+    ++ws.counts.points;
+    const double value = stage.value(ray.at(s));
     ray.lastS = s;
     ray.lastF = value;
     return value;
   }
 
   /// A piece no longer than a leaf whose interval did not exclude 0.
-  bool leaf(Workspace& ws, Stage& stage, Ray& ray, double a, double b)
+  bool leaf(Workspace& ws, detail::Stage& stage, Ray& ray, double a, double b)
   {
     const double fa = f(ws, stage, ray, a);
     if (fa >= 0)
@@ -513,9 +593,8 @@ private:
       double inside = b;
       auto g = [&](double s)
       {
-        const Point3 p = ray.at(s);
-        ++ws.points;
-        const double value = stage.point().eval(p[0], p[1], p[2], options_.time);
+        ++ws.counts.points;
+        const double value = stage.value(ray.at(s));
         if (value >= 0)
         {
           inside = std::min(inside, s);
@@ -548,7 +627,7 @@ private:
 
   /// A crossing found at depth s (f >= 0 at depth `inside`): the pixel's surface, unless a piece
   /// in front of it was left unresolved more than a leaf before.
-  void found(Workspace& ws, Stage& stage, const Ray& ray, double s, double inside)
+  void found(Workspace& ws, detail::Stage& stage, const Ray& ray, double s, double inside)
   {
     const double u = unresolvedAt(ws, ray.i, ray.j);
     if (!std::isnan(u) && (s - u) * ray.length > footprint(u))
@@ -556,75 +635,56 @@ private:
       hit(ws, *ws.root, ray, u, u, true);
       return;
     }
-    hit(ws, stage, ray, s, inside, false);
-    ws.cut += s == ray.start ? 1 : 0;
+    if (hit(ws, stage, ray, s, inside, false))
+    {
+      ws.counts.cut += s == ray.start ? 1 : 0;
+      ws.counts.eyeInside += s == ray.start && eyeInBox_ && ray.start == near_ ? 1 : 0;
+    }
   }
 
   /// Records the pixel's surface at depth s; `inside` is a depth at which f >= 0 (where the
-  /// model's colour is taken) unless the hit is unresolved.
-  void hit(Workspace& ws, Stage& stage, const Ray& ray, double s, double inside, bool unresolved)
+  /// paint is taken) unless the hit is unresolved. False when the canvas holds a nearer one.
+  bool hit(
+    Workspace& ws, detail::Stage& stage, const Ray& ray, double s, double inside, bool unresolved)
   {
     done(ws, ray.i, ray.j) = 1;
-    ++ws.covered;
-    ws.unresolved += unresolved ? 1 : 0;
-    const std::size_t index =
-      static_cast<std::size_t>(ray.j) * static_cast<std::size_t>(camera_.width()) +
-      static_cast<std::size_t>(ray.i);
-    out_.depth[index] = s * ray.length;
-
-    double colour[3] = { NeutralGrey, NeutralGrey, NeutralGrey };
-    if (colourOffset_ >= 0 && !unresolved)
+    const Paint paint = ws.painter && !unresolved ? ws.painter->at(ray.at(inside)) : Paint{};
+    // A solid cut by its box shows the cut flat, lit by the face's normal (its gradient there
+    // belongs to no surface: on a tie of a min or max it even flips from pixel to pixel).
+    frep::Point3 normal{ 0, 0, 0 };
+    if (!unresolved && s == ray.start && ray.face >= 0)
     {
-      const Point3 p = ray.at(inside);
-      double value = 0;
-      ws.attributes->eval({ p[0], p[1], p[2], options_.time }, value, ws.attributeValues.data());
-      for (int c = 0; c < 3; ++c)
-      {
-        const double x = ws.attributeValues[static_cast<std::size_t>(colourOffset_) + c];
-        colour[c] = std::isfinite(x) ? std::clamp(x, 0.0, 1.0) : NeutralGrey;
-      }
+      normal[static_cast<std::size_t>(ray.face)] = 1;
     }
-    // A headlight: the light comes from the eye along the ray, so |n . ray| is the cosine.
-    const Point3 p = ray.at(s);
-    const frep::ValueGradient g = stage.gradient().eval(p[0], p[1], p[2], options_.time);
-    const Point3 n = [&]
+    else
     {
-      const auto o = frep::outwardNormal(g);
-      return Point3{ o[0], o[1], o[2] };
-    }();
-    const double facing = frep::norm(n) > 0
-      ? std::abs(frep::dot(n, ray.direction)) / ray.length
-      : 1.0; // no gradient (a flat spot, or a cut by the box): lit as if facing the eye
-    const double light = Ambient + Diffuse * facing;
-    std::uint8_t* rgba = &out_.colour[4 * index];
-    for (int c = 0; c < 3; ++c)
-    {
-      rgba[c] =
-        static_cast<std::uint8_t>(std::lround(255 * std::clamp(colour[c] * light, 0.0, 1.0)));
+      normal = stage.gradient(ray.at(s));
     }
-    rgba[3] = 255;
+    const double light = headlight(normal, ray.direction, ray.length);
+    if (!canvas_.put(canvas_.index(ray.i, ray.j), s * ray.length, light, paint, solid_.owner))
+    {
+      return false;
+    }
+    ++ws.counts.covered;
+    ws.counts.unresolved += unresolved ? 1 : 0;
+    return true;
   }
 
-  const TapePtr& tape_;
-  const frep::Hypervolume* model_;
+  Canvas& canvas_;
+  const detail::Solid& solid_;
   Box3 box_;
   const Camera& camera_;
   const RayCastOptions& options_;
-  RayCastResult& out_;
   double tolerance_ = 0;
   double pad_ = 0;
   double near_ = 0;
   double far_ = 0;
-  std::ptrdiff_t colourOffset_ = -1;
+  bool limited_ = false;
+  bool eyeInBox_ = false; // rays start at the camera, not where they enter the box
 };
 
-RayCastResult cast(const TapePtr& tape, const frep::Hypervolume* model, const Box3& box,
-  const Camera& camera, const RayCastOptions& options)
+void checkBox(const Box3& box)
 {
-  if (!tape)
-  {
-    throw std::invalid_argument("rayCast: no tape");
-  }
   for (int a = 0; a < 3; ++a)
   {
     if (!std::isfinite(box.lo[a]) || !std::isfinite(box.hi[a]) || box.lo[a] > box.hi[a])
@@ -632,6 +692,108 @@ RayCastResult cast(const TapePtr& tape, const frep::Hypervolume* model, const Bo
       throw std::invalid_argument("rayCast: the box must be finite with lo <= hi");
     }
   }
+}
+
+/// Where a model's attribute `name` (empty: its colour, "colour" or "color" with 3 or 4
+/// components, if any) starts among its attribute values, and whether it is a scalar; -1: none.
+std::pair<std::ptrdiff_t, bool> attributeOf(const frep::Hypervolume& model, const std::string& name)
+{
+  std::size_t offset = 0;
+  for (const frep::Attribute& a : model.attributes())
+  {
+    const std::size_t n = a.components.size();
+    if (name.empty() ? (a.name == "colour" || a.name == "color") && (n == 3 || n == 4)
+                     : a.name == name)
+    {
+      if (n != 1 && n != 3 && n != 4)
+      {
+        throw std::invalid_argument("the attribute '" + name + "' has " + std::to_string(n) +
+          " components: a colour has 3 (or 4), a scalar 1");
+      }
+      return { static_cast<std::ptrdiff_t>(offset), n == 1 };
+    }
+    offset += n;
+  }
+  if (!name.empty())
+  {
+    std::string known;
+    for (const frep::Attribute& a : model.attributes())
+    {
+      known += (known.empty() ? "" : ", ") + a.name;
+    }
+    throw std::invalid_argument("the model has no attribute '" + name +
+      "' (it has: " + (known.empty() ? std::string("none") : known) + ")");
+  }
+  return { -1, false };
+}
+
+RayCastResult castModel(const TapePtr& tape, const frep::Hypervolume* model, const Box3& box,
+  const Camera& camera, const RayCastOptions& options)
+{
+  if (!tape)
+  {
+    throw std::invalid_argument("rayCast: no tape");
+  }
+  if (tape->parameterCount() > options.parameters.size())
+  {
+    throw std::invalid_argument("rayCast: the model has " + std::to_string(tape->parameterCount()) +
+      " parameter(s) but " + std::to_string(options.parameters.size()) + " value(s) were given");
+  }
+  std::pair<std::ptrdiff_t, bool> attribute{ -1, false };
+  if (model)
+  {
+    attribute = attributeOf(*model, options.colours.attribute);
+  }
+  const bool scalar = attribute.first >= 0 && attribute.second;
+  ColourMap::named(options.colours.map); // an unknown map fails before the work
+  Canvas canvas(
+    camera.width(), camera.height(), scalar ? Canvas::Colouring::Scalar : Canvas::Colouring::Rgb);
+  detail::Solid solid;
+  solid.box = box;
+  solid.stage = [&]
+  {
+    return std::make_unique<TapeStage>(tape, options.parameters, options.time);
+  };
+  if (attribute.first >= 0)
+  {
+    solid.painter = [&]
+    {
+      return std::make_unique<AttributePainter>(*model, options.parameters, options.time,
+        static_cast<std::size_t>(attribute.first), scalar);
+    };
+  }
+  const detail::CastCounts counts = detail::cast(canvas, solid, camera, options);
+  RayCastResult result;
+  if (scalar)
+  {
+    result.scalarRange = finishColours(canvas, options.colours);
+  }
+  result.width = canvas.width;
+  result.height = canvas.height;
+  result.colour = std::move(canvas.colour);
+  result.depth = std::move(canvas.depth);
+  result.coveredPixels = counts.covered;
+  result.unresolvedPixels = counts.unresolved;
+  result.cutPixels = counts.cut;
+  result.intervalEvaluations = counts.intervals;
+  result.pointEvaluations = counts.points;
+  return result;
+}
+
+} // namespace
+
+namespace detail
+{
+
+std::unique_ptr<Stage> fieldStage(const frep::Field& field)
+{
+  return std::make_unique<FieldStage>(field.evaluator());
+}
+
+CastCounts cast(
+  Canvas& canvas, const Solid& solid, const Camera& camera, const RayCastOptions& options)
+{
+  checkBox(solid.box);
   if (!std::isfinite(options.depthTolerance) || options.depthTolerance < 0)
   {
     throw std::invalid_argument("rayCast: the depth tolerance must be finite and >= 0");
@@ -644,28 +806,25 @@ RayCastResult cast(const TapePtr& tape, const frep::Hypervolume* model, const Bo
   {
     throw std::invalid_argument("rayCast: the time must be finite");
   }
-  if (tape->parameterCount() > options.parameters.size())
+  if (canvas.width != camera.width() || canvas.height != camera.height())
   {
-    throw std::invalid_argument("rayCast: the model has " + std::to_string(tape->parameterCount()) +
-      " parameter(s) but " + std::to_string(options.parameters.size()) + " value(s) were given");
+    throw std::invalid_argument("rayCast: the canvas and the camera differ in size");
   }
-  RayCastResult result;
-  RayCaster(tape, model, box, camera, options, result).run();
-  return result;
+  return RayCaster(canvas, solid, camera, options).run();
 }
 
-} // namespace
+} // namespace detail
 
 RayCastResult rayCast(
   const TapePtr& field, const Box3& box, const Camera& camera, const RayCastOptions& options)
 {
-  return cast(field, nullptr, box, camera, options);
+  return castModel(field, nullptr, box, camera, options);
 }
 
 RayCastResult rayCast(const frep::Hypervolume& model, const Box3& box, const Camera& camera,
   const RayCastOptions& options)
 {
-  return cast(frep::Tape::compile(model.geometry().function()), &model, box, camera, options);
+  return castModel(frep::Tape::compile(model.geometry().function()), &model, box, camera, options);
 }
 
 } // namespace ictk::render

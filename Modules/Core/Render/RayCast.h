@@ -63,8 +63,11 @@
 #include "FRep/Progress.h"
 #include "FRep/Tape.h"
 #include "Render/Camera.h"
+#include "Render/Canvas.h"
 
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace ictk::render
@@ -84,6 +87,8 @@ struct RayCastOptions
   int tileSize = 16;
   /// Progress and cancellation (FRep/Progress.h): counted per finished tile.
   Progress progress;
+  /// How the model's attributes colour it (Canvas.h).
+  ColourOptions colours;
 };
 
 /// The pictures a ray cast gives, pixel (i, j) at index j * width + i, row 0 at the bottom.
@@ -107,6 +112,9 @@ struct RayCastResult
   /// Interval evaluations of the tape (any length), and point evaluations of f.
   std::int64_t intervalEvaluations = 0;
   std::int64_t pointEvaluations = 0;
+  /// Coloured by a scalar attribute: the values at the colour map's ends (else NaN).
+  std::array<double, 2> scalarRange{ std::numeric_limits<double>::quiet_NaN(),
+    std::numeric_limits<double>::quiet_NaN() };
 };
 
 /// The solid f >= 0 of `field` (the tape's first output) inside `box`, seen by `camera`, in a
@@ -115,9 +123,12 @@ struct RayCastResult
 RayCastResult rayCast(const frep::TapePtr& field, const frep::Box3& box, const Camera& camera,
   const RayCastOptions& options = {});
 
-/// The same for a hypervolume's geometry, coloured by its attribute named "colour" (or "color")
-/// with 3 or 4 components in [0, 1] (the last is ignored), evaluated at the first point found
-/// inside the solid on the ray; neutral grey when it has none.
+/// The same for a hypervolume's geometry, coloured by the attribute options.colours names (by
+/// default its attribute named "colour" (or "color") with 3 or 4 components in [0, 1], the last
+/// ignored; neutral grey when it has none), evaluated at the first point found inside the solid
+/// on the ray; a scalar attribute through the colour map. Also throws std::invalid_argument for
+/// an attribute the model does not have or that is neither a colour nor a scalar, an unknown
+/// colour map or a reversed range.
 RayCastResult rayCast(const frep::Hypervolume& model, const frep::Box3& box, const Camera& camera,
   const RayCastOptions& options = {});
 
