@@ -6,10 +6,15 @@
 
 #include "Skin/SkinFile.h"
 #include "Skin/SkinnedMesh.h"
+#include "Skin/StandIn.h"
+
+#include "FRep/Evaluators.h"
+#include "FRep/Tape.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -308,4 +313,118 @@ TEST(SkinFile, BadFilesNameTheFile)
   SkinnedMesh m = readSkinnedMesh(model("X/BCN_Epileptic.X"));
   EXPECT_EQ(errorOf([&] { m.animation("Walk"); }),
     model("X/BCN_Epileptic.X") + ": no animation named 'Walk' (it has 'Epileptisch')");
+}
+
+// --- Implicit stand-ins (thesis 5.4)
+// ---------------------------------------------------------------
+
+namespace
+{
+
+/// An open tube of radius 0.3 around the z axis for |z| <= 0.6 (40 sides, 13 rings), skinned to
+/// a bone from (0, 0, -1.5) to (0, 0, 1.5): its joints' offsets are the translations that bring
+/// their markers to the origin.
+SkinnedMesh tube()
+{
+  SkinnedMesh m;
+  m.file = "tube";
+  m.nodes = { { "root", -1, {} }, { "hip", 0, translation(0, 0, -1.5) },
+    { "knee", 1, translation(0, 0, 3) } };
+  m.joints = { { 1, translation(0, 0, 1.5) }, { 2, translation(0, 0, -1.5) } };
+  const int sides = 40, rings = 13;
+  for (int k = 0; k < rings; ++k)
+    for (int i = 0; i < sides; ++i)
+    {
+      double a = 2 * pi * i / sides;
+      m.restPoints.push_back(
+        { 0.3 * std::cos(a), 0.3 * std::sin(a), -0.6 + 1.2 * k / (rings - 1) });
+      m.influences.push_back({ 0, 1.0 });
+      m.influenceStart.push_back(m.influences.size());
+    }
+  for (int k = 0; k + 1 < rings; ++k)
+    for (int i = 0; i < sides; ++i)
+    {
+      int p = k * sides + i, q = k * sides + (i + 1) % sides;
+      m.triangles.push_back({ p, q, q + sides });
+      m.triangles.push_back({ p, q + sides, p + sides });
+    }
+  m.validate();
+  return m;
+}
+
+double fieldAt(const ictk::frep::Shape& shape, const Vec3& p)
+{
+  ictk::frep::PointEvaluator e(ictk::frep::Tape::compile(shape.function()));
+  return e.eval(p[0], p[1], p[2]);
+}
+
+} // namespace
+
+TEST(StandIn, InitialApproximationOfATube)
+{
+  // One bone; its marker segment (0, 0, -1.5) -> (0, 0, 1.5) lies 0.3 from every vertex.
+  SkinnedMesh m = tube();
+  StandIn s = initialStandIn(m);
+  ASSERT_EQ(s.segments.size(), 1u);
+  expectNear(s.segments[0].a, { 0, 0, -1.5 }, 1e-15, "hip marker");
+  expectNear(s.segments[0].b, { 0, 0, 1.5 }, 1e-15, "knee marker");
+  EXPECT_NEAR(s.segments[0].radius, 0.3, 1e-12);
+  // The field is 0 at distance r from the segment's middle, positive inside, negative outside.
+  ictk::frep::Shape f = standInShape(s);
+  EXPECT_NEAR(fieldAt(f, { 0.3, 0, 0 }), 0, 1e-12);
+  EXPECT_NEAR(fieldAt(f, { 0, -0.3, 0 }), 0, 1e-12);
+  EXPECT_GT(fieldAt(f, { 0.1, 0, 0.5 }), 0);
+  EXPECT_LT(fieldAt(f, { 0.5, 0, 0 }), 0);
+}
+
+TEST(StandIn, TheFitRecoversATubesRadius)
+{
+  // Started at 0.2 (too thin), the projected Levenberg-Marquardt fit of the algebraic distance
+  // comes back to the tube's 0.3: the segment is long against the tube (its ends 0.9 beyond the
+  // last ring), so its field is nearly the infinite line's there.
+  SkinnedMesh m = tube();
+  StandIn s = initialStandIn(m);
+  s.segments[0].radius = 0.2;
+  StandInFitReport r = fitStandIn(s, m.restPoints);
+  EXPECT_NEAR(s.segments[0].radius, 0.3, 0.003);
+  EXPECT_LT(r.finalCost, 1e-3 * r.initialCost);
+  EXPECT_LT(r.finalMeanDistance, 0.01);
+  EXPECT_GT(r.initialMeanDistance, 0.3); // measured: 0.39
+  EXPECT_GE(r.iterations, 1);
+  // The bounds hold: [0.25, 4] x the starting radius.
+  s.segments[0].radius = 0.05;
+  fitStandIn(s, m.restPoints, { 0.25, 2.0 });
+  EXPECT_NEAR(s.segments[0].radius, 0.1, 1e-12);
+}
+
+TEST(StandIn, EpilepticsStandInFitsAndFollowsTheSkeleton)
+{
+  if (!canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  SkinnedMesh m = readSkinnedMesh(model("X/BCN_Epileptic.X"));
+  StandIn s = initialStandIn(m);
+  EXPECT_GT(s.segments.size(), 30u);
+  for (const StandInSegment& g : s.segments)
+    EXPECT_GT(g.radius, 0);
+  StandInFitReport r = fitStandIn(s, m.restPoints);
+  std::printf("BCN_Epileptic stand-in: %zu segments, mean |F| %.4f -> %.4f, cost %.4g -> %.4g, "
+              "%d iterations, %.3f s\n",
+    s.segments.size(), r.initialMeanDistance, r.finalMeanDistance, r.initialCost, r.finalCost,
+    r.iterations, r.seconds);
+  EXPECT_LT(r.finalCost, r.initialCost);
+  EXPECT_LT(r.finalMeanDistance, r.initialMeanDistance);
+  // At every frame the posed segments' ends are the posed joints' origins.
+  const Animation& a = m.animation("Epileptisch");
+  for (int k = 0; k <= 4; ++k)
+  {
+    double t = a.durationSeconds() * k / 4;
+    std::vector<Affine> globals = poseNodes(m, &a, t);
+    StandIn posed = poseStandIn(s, jointMatrices(m, globals));
+    for (const StandInSegment& g : posed.segments)
+    {
+      expectNear(
+        g.a, globals[static_cast<std::size_t>(m.joints[g.parentJoint].node)].b, 1e-9, "start");
+      expectNear(g.b, globals[static_cast<std::size_t>(m.joints[g.joint].node)].b, 1e-9, "end");
+    }
+  }
 }

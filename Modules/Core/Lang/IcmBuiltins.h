@@ -35,6 +35,7 @@ enum class BuiltinId
   Arc,
   CircularSegment,
   SetShapeParameter,
+  JointPosition,
   Vec3,
   Length,
   Dot,
@@ -108,6 +109,7 @@ enum class ShapeId
   Sphere,
   Blend,
   Union,
+  LoadMesh,
   Count ///< not a constructor: the number of them
 };
 
