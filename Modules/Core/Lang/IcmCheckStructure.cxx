@@ -360,39 +360,7 @@ void Checker::shape(const ExprPtr& v, const CellMap& cells)
   }
 }
 
-bool Checker::isMeshCell(const std::string& name, const CellMap* cells, int depth) const
-{
-  const CellDef* def = nullptr;
-  if (cells && cells->count(name))
-  {
-    def = cells->at(name);
-  }
-  else if (globalCells_.count(name))
-  {
-    def = globalCells_.at(name);
-  }
-  if (!def || depth > 64)
-  {
-    return false;
-  }
-  const Property* p = def->property("shape");
-  if (!p)
-  {
-    // A copy `B <- A` has A's shape unless it gives its own.
-    return !def->source.text.empty() && isMeshCell(def->source.text, cells, depth + 1);
-  }
-  for (const ExprPtr& v : p->values)
-  {
-    if (v->kind == Expr::Kind::Call && v->text == "file" && v->kids.size() == 2 &&
-      v->kids[1]->kind == Expr::Kind::String && isMeshFile(v->kids[1]->text))
-    {
-      return true;
-    }
-  }
-  return loadMeshOf(name, cells, depth) != nullptr;
-}
-
-const Expr* Checker::loadMeshOf(const std::string& name, const CellMap* cells, int depth) const
+const Property* Checker::shapeOf(const std::string& name, const CellMap* cells, int depth) const
 {
   const CellDef* def = nullptr;
   if (cells && cells->count(name))
@@ -408,9 +376,38 @@ const Expr* Checker::loadMeshOf(const std::string& name, const CellMap* cells, i
     return nullptr;
   }
   const Property* p = def->property("shape");
+  if (!p && !def->source.text.empty())
+  {
+    // A copy `B <- A` has A's shape unless it gives its own.
+    return shapeOf(def->source.text, cells, depth + 1);
+  }
+  return p;
+}
+
+bool Checker::isMeshCell(const std::string& name, const CellMap* cells) const
+{
+  const Property* p = shapeOf(name, cells);
   if (!p)
   {
-    return def->source.text.empty() ? nullptr : loadMeshOf(def->source.text, cells, depth + 1);
+    return false;
+  }
+  for (const ExprPtr& v : p->values)
+  {
+    if (v->kind == Expr::Kind::Call && v->text == "file" && v->kids.size() == 2 &&
+      v->kids[1]->kind == Expr::Kind::String && isMeshFile(v->kids[1]->text))
+    {
+      return true;
+    }
+  }
+  return loadMeshOf(name, cells) != nullptr;
+}
+
+const Expr* Checker::loadMeshOf(const std::string& name, const CellMap* cells) const
+{
+  const Property* p = shapeOf(name, cells);
+  if (!p)
+  {
+    return nullptr;
   }
   for (const ExprPtr& v : p->values)
   {

@@ -157,9 +157,11 @@ private:
   void shape(const ExprPtr& v, const CellMap& cells);
   /// Whether the named cell's shape is a mesh file (file("*.obj" or "*.off")): an explicit surface
   /// that the geometric queries, blends and unions do not take.
-  bool isMeshCell(const std::string& name, const CellMap* cells, int depth = 0) const;
+  bool isMeshCell(const std::string& name, const CellMap* cells) const;
   /// The `loadMesh(...)` call of the named cell's shape, or nullptr.
-  const Expr* loadMeshOf(const std::string& name, const CellMap* cells, int depth = 0) const;
+  const Expr* loadMeshOf(const std::string& name, const CellMap* cells) const;
+  /// The named cell's `shape =` property (a copy's source's when it gives none), or nullptr.
+  const Property* shapeOf(const std::string& name, const CellMap* cells, int depth = 0) const;
   /// loadMesh("path", "animation"): the file is read (Skin/SkinFile.h) and the animation looked
   /// up, so that what cannot work is refused here, at its place.
   void loadMesh(const Expr& call);
