@@ -18,6 +18,7 @@
 #include <vtkNew.h>
 #include <vtkPartitionedDataSet.h>
 #include <vtkPartitionedDataSetCollection.h>
+#include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
@@ -27,6 +28,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -294,5 +296,58 @@ TEST(DynamicsVTK, ReportsModelErrorsWithTheirPlace)
   EXPECT_NE(message.find(bad.string() + ":3:"), std::string::npos) << message;
   EXPECT_NE(message.find("error"), std::string::npos) << message;
 }
+
+#ifdef ICTK_WITH_ASSIMP
+// Issue 17: a skinned mesh (glTF2/simple_skin of Debian's assimp-testmodels: a strip of 10
+// vertices on two joints, its upper joint turning about z) as a B-cell: its polydata per frame
+// moves with the animation and carries, per vertex, the joint that weighs most on it and that
+// weight (row k of the strip weighs (1 - k/4, k/4); the first joint wins the tie of row 2).
+TEST(DynamicsVTK, SkinnedMeshFramesCarryTheirDominantJoint)
+{
+  const std::filesystem::path model = std::filesystem::temp_directory_path() /
+    ("ictk-dynamics-skin-" + std::to_string(::getpid()) + ".icm");
+  {
+    std::ofstream out(model);
+    out << "name = STRIP;\nTIMESPANS { film : TIMESPAN(0, 5.5); }\n"
+           "CELLS { Strip { type = B-CELL; shape = loadMesh(\""
+        << ICTK_ASSIMP_MODELS
+        << "/glTF2/simple_skin/simple_skin.gltf\", \"\"); dim = 2D; } }\n"
+           "K { CELLS { Strip; } }\n";
+  }
+  vtkNew<ictkDynamicComplexSource> source;
+  source->SetFileName(model.string().c_str());
+  source->SetTimeStepSize(0.5);
+  std::vector<double> minX;
+  for (double t : { 0.0, 0.5, 1.0 })
+  {
+    ASSERT_EQ(source->UpdateTimeStep(t), 1);
+    auto* output = vtkPartitionedDataSetCollection::SafeDownCast(source->GetOutputDataObject(0));
+    vtkPolyData* strip = Cell(output, "Strip");
+    ASSERT_NE(strip, nullptr);
+    ASSERT_EQ(strip->GetNumberOfPoints(), 10);
+    EXPECT_EQ(strip->GetNumberOfPolys(), 8);
+    auto* joint = vtkDoubleArray::SafeDownCast(strip->GetPointData()->GetArray("DominantJoint"));
+    auto* weight =
+      vtkDoubleArray::SafeDownCast(strip->GetPointData()->GetArray("DominantJointWeight"));
+    ASSERT_NE(joint, nullptr);
+    ASSERT_NE(weight, nullptr);
+    const double joints[10] = { 0, 0, 0, 0, 0, 0, 1, 1, 1, 1 };
+    const double weights[10] = { 1, 1, 0.75, 0.75, 0.5, 0.5, 0.75, 0.75, 1, 1 };
+    for (vtkIdType i = 0; i < 10; ++i)
+    {
+      EXPECT_EQ(joint->GetValue(i), joints[i]) << "vertex " << i;
+      EXPECT_EQ(weight->GetValue(i), weights[i]) << "vertex " << i;
+    }
+    double bounds[6];
+    strip->GetBounds(bounds);
+    minX.push_back(bounds[0]);
+  }
+  std::filesystem::remove(model);
+  // The rest pose spans x in [-0.5, 0.5]; at 1 s the top row has swung to x = -1.
+  EXPECT_NEAR(minX[0], -0.5, 1e-6);
+  EXPECT_LT(minX[1], -0.5 - 0.1);
+  EXPECT_NEAR(minX[2], -1, 1e-6);
+}
+#endif
 
 } // namespace

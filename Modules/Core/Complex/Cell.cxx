@@ -74,6 +74,15 @@ void checkExplicit(const Cell& cell, const ExplicitGeometry& g)
       }
     }
   }
+  for (const discretize::PointArray& a : g.pointData)
+  {
+    if (a.components < 1 || a.values.size() != g.points.size() * std::size_t(a.components))
+    {
+      fail(cell,
+        "point array '" + a.name + "' is not " + std::to_string(a.components) +
+          " value(s) per point");
+    }
+  }
   const auto n = static_cast<std::uint32_t>(g.points.size());
   auto checkIndex = [&](std::uint32_t index, const char* what, std::size_t element)
   {

@@ -10,6 +10,7 @@
 //  - as a mapped FRep (MappedFCell): a 2D FRep in the (u, v) plane pushed into E^3 by h;
 //  - explicitly: points, polylines, triangles or tetrahedra (a characteristic map, sampled).
 
+#include "Discretize/Mesh.h"
 #include "FRep/Expr.h"
 #include "FRep/Field.h"
 
@@ -79,6 +80,9 @@ struct ExplicitGeometry
   std::vector<std::vector<std::uint32_t>> polylines;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::array<std::uint32_t, 4>> tetrahedra;
+  /// Values given per point with the geometry (a skinned mesh's dominant joint), carried to the
+  /// cell's discretisation as point arrays (2D and lower; a 3D cell's boundary has new points).
+  std::vector<discretize::PointArray> pointData;
 };
 
 using CellGeometry = std::variant<ImplicitGeometry, MappedGeometry, ExplicitGeometry>;

@@ -95,14 +95,17 @@ void discretizeExplicit(const Cell& c, const ExplicitGeometry& g, CellMesh& out)
   {
     case 0:
       out.points.points = g.points;
+      out.points.pointData = g.pointData;
       break;
     case 1:
       out.curves.points = g.points;
       out.curves.lines = g.polylines;
+      out.curves.pointData = g.pointData;
       break;
     case 2:
       out.surface.points = g.points;
       out.surface.triangles = g.triangles;
+      out.surface.pointData = g.pointData;
       break;
     default:
       out.surface = tetrahedraBoundary(g);

@@ -232,7 +232,18 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
       Kept kept;
       kept.version = state.shapeVersion;
       kept.local = complex::discretizeCell(one, localId, cellOptions);
-      kept.local.pointData().clear();
+      // Attributes are evaluated where the points are, every frame; the point arrays that come
+      // with an explicit geometry (a skinned mesh's dominant joint) go with the points.
+      const auto* given = std::get_if<complex::ExplicitGeometry>(&one.cell(localId).geometry);
+      auto& arrays = kept.local.pointData();
+      arrays.erase(std::remove_if(arrays.begin(), arrays.end(),
+                     [&](const discretize::PointArray& a)
+                     {
+                       return !given ||
+                         std::none_of(given->pointData.begin(), given->pointData.end(),
+                           [&](const discretize::PointArray& g) { return g.name == a.name; });
+                     }),
+        arrays.end());
       kept.worldParts = worldParts;
       kept.madeUnder = shape.place;
       kept.lastPlace = shape.place;

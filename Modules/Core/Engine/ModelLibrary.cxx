@@ -124,6 +124,28 @@ Value setShapeParameter(const LibraryCall& call)
   return {};
 }
 
+/// jointPosition(cell, "joint"): the joint's origin posed at the cell's time, placed by the cell.
+Value jointPosition(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const Value& cell = call.args.at(0);
+  if (cell.type != Value::Type::Cell)
+    throw std::runtime_error("the first argument is a cell");
+  const CellSpec& c = m.cells[m.cellIndex.at(cell.text)];
+  if (!c.skinned)
+    throw std::runtime_error("the cell " + cell.text + " is not a skinned mesh (loadMesh)");
+  const std::string& joint = call.args.at(1).text;
+  const auto& nodes = c.skinned->nodes;
+  const auto it =
+    std::find_if(nodes.begin(), nodes.end(), [&](const skin::Node& n) { return n.name == joint; });
+  if (it == nodes.end())
+    throw std::runtime_error("no joint named '" + joint + "' in " + c.skinned->file);
+  const std::vector<Affine> globals =
+    skin::poseNodes(*c.skinned, c.skinAnimation, m.animationTime(c));
+  return Value::vector(
+    m.place(cell.text).apply(globals[static_cast<std::size_t>(it - nodes.begin())].b));
+}
+
 Value fireEvent(const LibraryCall& call)
 {
   ModelState& m = call.m;
@@ -197,6 +219,7 @@ const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
   { BuiltinId::Arc, shapePartOf },
   { BuiltinId::CircularSegment, shapePartOf },
   { BuiltinId::SetShapeParameter, setShapeParameter },
+  { BuiltinId::JointPosition, jointPosition },
 };
 
 } // namespace

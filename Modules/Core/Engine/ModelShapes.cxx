@@ -7,6 +7,7 @@
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 #include "Lang/MeshFile.h"
+#include "Skin/SkinFile.h"
 
 #include "FRep/Operations.h"
 
@@ -106,6 +107,43 @@ void fileShape(const ShapeCall& s)
   catch (const std::exception& e)
   {
     s.fail("cannot read the shape file '" + path + "': " + e.what());
+  }
+}
+
+/// loadMesh("file", "animation"): a skinned mesh (thesis Appendix B's Andy), its mesh part posed
+/// at the cell's time by partsOf.
+void loadMeshShape(const ShapeCall& s)
+{
+  for (std::size_t i = 0; i < 2; ++i)
+    if (i >= s.args.size() || s.args[i].type != Value::Type::String)
+      s.fail("loadMesh(\"path\", \"animation\") takes two strings");
+  const std::string path = lang::modelFilePath(s.m.model, s.args[0].text);
+  try
+  {
+    auto mesh = std::make_shared<const skin::SkinnedMesh>(skin::readSkinnedMesh(path));
+    s.c.skinAnimation = &mesh->animation(s.args[1].text);
+    ShapePart part;
+    part.kind = ShapePart::Kind::Mesh;
+    part.points = mesh->restPoints;
+    for (const auto& t : mesh->triangles)
+      part.triangles.push_back({ static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
+        static_cast<std::uint32_t>(t[2]) });
+    // The joint that weighs most on each vertex, for colouring a frame by its skeleton.
+    ictk::discretize::PointArray joint{ "DominantJoint", 1, {} },
+      weight{ "DominantJointWeight", 1, {} };
+    for (const skin::Influence& f : mesh->dominantInfluences())
+    {
+      joint.values.push_back(f.joint);
+      weight.values.push_back(f.weight);
+    }
+    part.pointData = { std::move(joint), std::move(weight) };
+    s.c.meshPart = s.c.parts.size();
+    s.c.skinned = std::move(mesh);
+    s.add(std::move(part));
+  }
+  catch (const std::exception& e)
+  {
+    s.fail(std::string("loadMesh: ") + e.what());
   }
 }
 
@@ -210,6 +248,7 @@ const std::pair<ShapeId, ShapeConstructor> kShapes[] = {
   { ShapeId::Blend, operandsShape<ShapePart::Kind::Blend> },
   { ShapeId::Union, operandsShape<ShapePart::Kind::Union> },
   { ShapeId::SpaceTimeBlend, spaceTimeBlendShape },
+  { ShapeId::LoadMesh, loadMeshShape },
 };
 
 } // namespace
@@ -226,6 +265,10 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
   c.operands.reset();
   c.fieldPart = kNone;
   c.spaceTime = false;
+  c.skinned.reset();
+  c.skinAnimation = nullptr;
+  c.meshPart = kNone;
+  c.posed.reset();
   if (p.isHyperFun)
   {
     try

@@ -13,6 +13,7 @@
 #include "Dynamics/Stepper.h"
 #include "Engine/DynamicModel.h"
 #include "FRep/Tape.h"
+#include "Skin/SkinnedMesh.h"
 
 #include <limits>
 #include <map>
@@ -95,6 +96,13 @@ struct CellSpec
     Pos pos;                                  ///< the constructor's call
   };
   std::optional<Operands> operands;
+  /// loadMesh("file", "animation"): a skinned mesh whose part `meshPart` is posed by the
+  /// animation at the cell's time (animationTime), cached for the last time posed.
+  std::shared_ptr<const skin::SkinnedMesh> skinned;
+  const skin::Animation* skinAnimation = nullptr;
+  std::size_t meshPart = kNone;
+  mutable double posedAt = kNaN;
+  mutable std::shared_ptr<const std::vector<ShapePart>> posed;
   std::vector<ParamSpec> params;
   std::map<std::string, const Procedure*> reactions; ///< "update", "react:EVENT", ...
 };
@@ -260,6 +268,12 @@ struct ModelState
     return std::find(cs.begin(), cs.end(), cell) != cs.end();
   }
   std::shared_ptr<const std::vector<ShapePart>> partsOf(const CellSpec& c) const;
+  /// The time a skinned cell's animation is at: the cell's local time when it has a `timespan`
+  /// (held before and after it), else the model's.
+  double animationTime(const CellSpec& c) const
+  {
+    return c.hasClock ? c.clock.elapsed(shapeTime()) : shapeTime();
+  }
   Affine localPlace(const std::string& cell) const;
   Affine place(const std::string& cell, int depth = 0) const;
   PlacedShapePtr shapeOf(const std::string& cell, int depth = 0) const;

@@ -120,6 +120,19 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
 {
   if (auto it = s.shapes.find(c.name); it != s.shapes.end())
     return it->second;
+  if (c.skinned)
+  {
+    // A skinned mesh posed at the cell's time; the queries of a frame ask for it many times.
+    const double t = animationTime(c);
+    if (!c.posed || !(c.posedAt == t))
+    {
+      auto posed = std::make_shared<std::vector<ShapePart>>(c.parts);
+      (*posed)[c.meshPart].points = skin::pose(*c.skinned, c.skinAnimation, t).points;
+      c.posed = std::move(posed);
+      c.posedAt = t;
+    }
+    return c.posed;
+  }
   auto parts = std::make_shared<std::vector<ShapePart>>(c.parts);
   if (c.fieldPart == kNone)
     return parts;
@@ -198,6 +211,9 @@ std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
   // A space-time cell's cross-section changes with time.
   if (c.spaceTime)
     v = mix(v, bitsOf(shapeTime()));
+  // A skinned mesh changes with its animation's time.
+  if (c.skinned)
+    v = mix(v, bitsOf(animationTime(c)));
   if (!c.operands || s.shapes.count(cell) || depth > static_cast<int>(cells.size()))
     return v;
   // A blend or union lives in world coordinates: it changes when an operand moves, and when its

@@ -12,6 +12,7 @@
 // The engine (Engine/DynamicModel) builds a cell's placed shape at an instant; its field
 // (PlacedShape::value, worldField) is >= 0 inside, as every FRep field.
 
+#include "Discretize/Mesh.h"
 #include "FRep/Field.h"
 #include "FRep/Operations.h"
 #include "FRep/Vector.h"
@@ -77,6 +78,9 @@ struct ShapePart
   /// Mesh: corners of the triangles, indices into points. An explicit surface is discretised as
   /// itself; the queries of Queries.h and worldField do not take it (they need a field).
   std::vector<std::array<std::uint32_t, 3>> triangles;
+  /// Mesh: values per point that go with it into the complex cell (a skinned mesh's dominant
+  /// joint and its weight).
+  std::vector<discretize::PointArray> pointData;
   Vec3 size{ 0, 0, 0 };
   double radius = 0.0;
   frep::FieldPtr field; ///< Field: evaluated at local coordinates (z = 0 when 2D)

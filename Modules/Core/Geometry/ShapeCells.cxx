@@ -40,6 +40,11 @@ complex::Cell meshCell(const PlacedShape& s)
       g.triangles.push_back({ t[0] + offset, t[1] + offset, t[2] + offset });
     }
   }
+  // Point arrays go with a shape of one mesh (several meshes need not share their arrays).
+  if (s.parts.size() == 1)
+  {
+    g.pointData = s.parts[0].pointData;
+  }
   complex::Cell cell = complex::explicitCell(s.cell, 2, std::move(g));
   return cell;
 }

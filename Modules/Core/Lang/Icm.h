@@ -34,6 +34,11 @@ IcmModel parseIcmNotation(
 /// The semantic checks alone, on a parsed model (appends to `out`, at most
 /// `limits.maxDiagnostics`). Inline HyperFun shapes are compiled with readHyperFun, and their
 /// errors are reported at their place in the model text.
+/// The file a model's `loadMesh("path", ...)` names: `path` itself when absolute, else relative to
+/// the model's folder (IcmModel::directory, or the folder of its fileName before readIcmFile sets
+/// it, as when the checker reads it).
+std::string modelFilePath(const IcmModel& model, const std::string& path);
+
 void checkIcm(const IcmModel& model, const std::string& text, std::vector<Diagnostic>& out,
   const Limits& limits = {});
 

@@ -70,6 +70,11 @@ const std::vector<Builtin>& builtins()
     { Id::SetShapeParameter, library,
       { "setShapeParameter", 3, 3, "setShapeParameter(cell, string name, real value)", "void" },
       "sets an FRep parameter (`a[1]`...) of an F-cell's HyperFun or XML shape" },
+    // The skeletons of skinned meshes (loadMesh cells).
+    { Id::JointPosition, library,
+      { "jointPosition", 2, 2, "jointPosition(cell, string joint)", "vec3" },
+      "where a joint (a node of the skeleton, by name) of a `loadMesh` cell is now, in world "
+      "coordinates" },
     // Vectors.
     { Id::Vec3, math, { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" }, "a vector" },
     { Id::Length, math, { "length", 1, 1, "length(vec3 v)", "real" }, "the Euclidean norm" },
@@ -154,6 +159,10 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
       "a blend of the two between, with the bounded blend's added material a0 and scales a1, a2 "
       "(the operands') and a3 (the time slab's); no defaults: they depend on the shapes' "
       "sizes and the interval's length" },
+    { Id::LoadMesh, { "loadMesh", 2, 2, "loadMesh(string path, string animation)", "shape" }, 0,
+      "a skinned, animated mesh (.x, .gltf, .fbx... read with Assimp; relative to the model's "
+      "folder) played by the named animation at the cell's time: a B-cell surface, `dim = 2D`, "
+      "placed by the cell; the queries, `blend` and `union` do not take it" },
   };
   return table;
 }

@@ -35,6 +35,7 @@ enum class BuiltinId
   Arc,
   CircularSegment,
   SetShapeParameter,
+  JointPosition,
   Vec3,
   Length,
   Dot,
@@ -109,6 +110,7 @@ enum class ShapeId
   Blend,
   Union,
   SpaceTimeBlend,
+  LoadMesh,
   Count ///< not a constructor: the number of them
 };
 

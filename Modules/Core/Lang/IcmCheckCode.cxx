@@ -3,6 +3,7 @@
 // types where they are known, assignments, bounded loops, and calls (model functions defined
 // earlier, the built-in library with the signatures of Lang/IcmBuiltins.h).
 #include "Lang/IcmChecker.h"
+#include "Skin/SkinnedMesh.h"
 
 #include <cmath>
 
@@ -732,7 +733,7 @@ Ty Checker::call(const Expr& e, Code& c)
       // The queries work on fields and analytic shapes; an explicit surface has neither.
       err(e.kids[i]->pos,
         "'" + fn + "' does not take meshes yet, and cell '" + e.kids[i]->text +
-          "' is a mesh (.obj/.off)");
+          "' is a mesh (.obj/.off, loadMesh)");
     }
     else if (i > cellArgs && t == Ty::Cell)
     {
@@ -741,7 +742,48 @@ Ty Checker::call(const Expr& e, Code& c)
           b->signature + ")");
     }
   }
+  if (builtin->id == BuiltinId::JointPosition && e.kids.size() == 3)
+  {
+    jointPosition(e, c.cells);
+  }
   return resultType(b->result);
+}
+
+void Checker::jointPosition(const Expr& call, const CellMap* cells)
+{
+  const ExprPtr& cell = call.kids[1];
+  const ExprPtr& joint = call.kids[2];
+  if (cell->kind != Expr::Kind::Name)
+  {
+    return;
+  }
+  const Expr* load = loadMeshOf(cell->text, cells);
+  if (!load)
+  {
+    err(cell->pos,
+      "jointPosition takes a skinned mesh, and cell '" + cell->text +
+        "' is not one (shape = loadMesh(...))");
+    return;
+  }
+  if (joint->kind != Expr::Kind::String || load->kids.size() != 3 ||
+    load->kids[1]->kind != Expr::Kind::String)
+  {
+    return;
+  }
+  // The file's own problems are reported at the loadMesh call.
+  const skin::SkinnedMesh* mesh = skinnedMesh(*load->kids[1], false);
+  if (!mesh)
+  {
+    return;
+  }
+  for (const skin::Node& n : mesh->nodes)
+  {
+    if (n.name == joint->text)
+    {
+      return;
+    }
+  }
+  err(joint->pos, "no joint named '" + joint->text + "' in " + mesh->file);
 }
 
 } // namespace ictk::lang::icmcheck

@@ -3,6 +3,9 @@
 // attributes.
 #include "Lang/IcmChecker.h"
 #include "Lang/MeshFile.h"
+#include "Skin/SkinFile.h"
+
+#include "Complex/Cell.h"
 
 namespace ictk::lang::icmcheck
 {
@@ -323,6 +326,11 @@ void Checker::shape(
     }
     return;
   }
+  if (shape->id == ShapeId::LoadMesh)
+  {
+    loadMesh(*v);
+    return;
+  }
   if (shape->cellArguments > 0)
   {
     for (std::size_t i = 1;
@@ -332,7 +340,8 @@ void Checker::shape(
       if (a->kind == Expr::Kind::Name && isMeshCell(a->text, &cells))
       {
         err(a->pos,
-          "'" + v->text + "' takes fields, and cell '" + a->text + "' is a mesh (.obj/.off)");
+          "'" + v->text + "' takes fields, and cell '" + a->text +
+            "' is a mesh (.obj/.off, loadMesh)");
       }
     }
   }
@@ -376,7 +385,7 @@ void Checker::shape(
   }
 }
 
-bool Checker::isMeshCell(const std::string& name, const CellMap* cells, int depth) const
+const Property* Checker::shapeOf(const std::string& name, const CellMap* cells, int depth) const
 {
   const CellDef* def = nullptr;
   if (cells && cells->count(name))
@@ -389,13 +398,23 @@ bool Checker::isMeshCell(const std::string& name, const CellMap* cells, int dept
   }
   if (!def || depth > 64)
   {
-    return false;
+    return nullptr;
   }
   const Property* p = def->property("shape");
-  if (!p)
+  if (!p && !def->source.text.empty())
   {
     // A copy `B <- A` has A's shape unless it gives its own.
-    return !def->source.text.empty() && isMeshCell(def->source.text, cells, depth + 1);
+    return shapeOf(def->source.text, cells, depth + 1);
+  }
+  return p;
+}
+
+bool Checker::isMeshCell(const std::string& name, const CellMap* cells) const
+{
+  const Property* p = shapeOf(name, cells);
+  if (!p)
+  {
+    return false;
   }
   for (const ExprPtr& v : p->values)
   {
@@ -405,7 +424,97 @@ bool Checker::isMeshCell(const std::string& name, const CellMap* cells, int dept
       return true;
     }
   }
-  return false;
+  return loadMeshOf(name, cells) != nullptr;
+}
+
+const Expr* Checker::loadMeshOf(const std::string& name, const CellMap* cells) const
+{
+  const Property* p = shapeOf(name, cells);
+  if (!p)
+  {
+    return nullptr;
+  }
+  for (const ExprPtr& v : p->values)
+  {
+    if (v->kind == Expr::Kind::Call && v->text == "loadMesh")
+    {
+      return v.get();
+    }
+  }
+  return nullptr;
+}
+
+const skin::SkinnedMesh* Checker::skinnedMesh(const Expr& path, bool report)
+{
+  const std::string file = modelFilePath(m_, path.text);
+  auto it = skinned_.find(file);
+  if (it == skinned_.end())
+  {
+    std::shared_ptr<const skin::SkinnedMesh> mesh;
+    std::string problem;
+    try
+    {
+      mesh = std::make_shared<const skin::SkinnedMesh>(skin::readSkinnedMesh(file));
+    }
+    catch (const std::exception& e)
+    {
+      problem = e.what();
+    }
+    it = skinned_.emplace(file, std::make_pair(mesh, problem)).first;
+  }
+  if (!it->second.first && report)
+  {
+    err(path.pos, "loadMesh: " + it->second.second);
+  }
+  return it->second.first.get();
+}
+
+void Checker::loadMesh(const Expr& call)
+{
+  const ExprPtr& path = call.kids[1];
+  const ExprPtr& animation = call.kids[2];
+  bool strings = true;
+  for (const ExprPtr& a : { path, animation })
+  {
+    if (a->kind != Expr::Kind::String)
+    {
+      err(a->pos, "loadMesh(\"path\", \"animation\") takes quoted strings");
+      strings = false;
+    }
+  }
+  if (!strings)
+  {
+    return;
+  }
+  const skin::SkinnedMesh* mesh = skinnedMesh(*path);
+  if (!mesh)
+  {
+    return;
+  }
+  try
+  {
+    // A B-cell's surface must be a manifold (complex::checkCell): many characters are not.
+    complex::ExplicitGeometry surface;
+    surface.points = mesh->restPoints;
+    for (const auto& t : mesh->triangles)
+    {
+      surface.triangles.push_back({ static_cast<std::uint32_t>(t[0]),
+        static_cast<std::uint32_t>(t[1]), static_cast<std::uint32_t>(t[2]) });
+    }
+    complex::checkCell(complex::explicitCell(mesh->file, 2, std::move(surface)));
+  }
+  catch (const std::exception& e)
+  {
+    err(path->pos, std::string("loadMesh: ") + e.what());
+  }
+  try
+  {
+    mesh->animation(animation->text);
+  }
+  catch (const std::exception& e)
+  {
+    err(animation->pos, std::string("loadMesh: ") + e.what());
+  }
 }
 
 std::string Checker::arity(const Signature& b)

@@ -15,9 +15,15 @@
 #include "Lang/IcmLexer.h"
 
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
+
+namespace ictk::skin
+{
+struct SkinnedMesh;
+}
 
 namespace ictk::lang::icmcheck
 {
@@ -95,6 +101,8 @@ private:
   std::map<std::string, const CellDef*> allCells_; ///< global and instance cells, first wins
   // Memoised closures over USE, bases and '<-' (with guards against cycles).
   mutable std::map<const CellDef*, std::set<std::string>> paramsCache_;
+  /// Skinned meshes read by path (nullptr with its message when the file cannot be read).
+  std::map<std::string, std::pair<std::shared_ptr<const skin::SkinnedMesh>, std::string>> skinned_;
   mutable std::set<const CellDef*> paramsBusy_;
   mutable std::map<const Instance*, CellMap> cellsCache_;
   mutable std::set<const Instance*> cellsBusy_;
@@ -153,7 +161,19 @@ private:
     const Instance* in = nullptr);
   /// Whether the named cell's shape is a mesh file (file("*.obj" or "*.off")): an explicit surface
   /// that the geometric queries, blends and unions do not take.
-  bool isMeshCell(const std::string& name, const CellMap* cells, int depth = 0) const;
+  bool isMeshCell(const std::string& name, const CellMap* cells) const;
+  /// The `loadMesh(...)` call of the named cell's shape, or nullptr.
+  const Expr* loadMeshOf(const std::string& name, const CellMap* cells) const;
+  /// The named cell's `shape =` property (a copy's source's when it gives none), or nullptr.
+  const Property* shapeOf(const std::string& name, const CellMap* cells, int depth = 0) const;
+  /// loadMesh("path", "animation"): the file is read (Skin/SkinFile.h) and the animation looked
+  /// up, so that what cannot work is refused here, at its place.
+  void loadMesh(const Expr& call);
+  /// The skinned mesh a loadMesh path argument names, read once; nullptr (and, when `report`, an
+  /// error at the argument) when it cannot be read.
+  const skin::SkinnedMesh* skinnedMesh(const Expr& path, bool report = true);
+  /// jointPosition(cell, "joint"): the cell is a loadMesh cell and its skeleton has the joint.
+  void jointPosition(const Expr& call, const CellMap* cells);
   static std::string arity(const Signature& b);
 
   // ---- attributes -------------------------------------------------------------------------------

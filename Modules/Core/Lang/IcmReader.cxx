@@ -70,6 +70,17 @@ IcmModel parseIcmNotation(
   return read(text, fileName, limits, true);
 }
 
+std::string modelFilePath(const IcmModel& model, const std::string& path)
+{
+  const std::filesystem::path p(path);
+  if (p.is_absolute())
+    return path;
+  const std::filesystem::path folder = model.directory.empty()
+    ? std::filesystem::path(model.fileName).parent_path()
+    : std::filesystem::path(model.directory);
+  return (folder / p).string();
+}
+
 IcmModel readIcmFile(const std::string& path, const Limits& limits)
 {
   const std::string text = readSourceFile(path, limits);
