@@ -14,6 +14,7 @@
 //   render-sphere-gyroid-1024  ray casting (Render/RayCast.h) of the same sphereGyroid, 1024^2
 //                         pixels from the default view, 2 threads; pixels/s and interval
 //                         evaluations per pixel
+//   render-walnut-1024    the same for the bundled walnut
 //   flower-256            the discretisation of every cell of Data/Models/flower/flower.json at
 //                         1/256 of its size (surfaces, patches, traced curves, points)
 //   andyhausen-100        a 10-second, 100-step run of Data/Models/icm/andyhausen.icm with the
@@ -339,16 +340,15 @@ Result SphereGyroid(double featureSize)
   return r;
 }
 
-Result RenderSphereGyroid(int size)
+/// Ray casting of one field over `box` into size^2 pixels, perspective from the default view.
+Result RenderField(const std::string& workload, const std::string& what, const frep::TapePtr& tape,
+  const frep::Box3& box, int size)
 {
   Result r;
-  r.workload = "render-sphere-gyroid-" + std::to_string(size);
-  r.what = "ray casting of libfive's sphereGyroid over [-5,5]^3, " + std::to_string(size) + "^2 " +
-    "pixels, perspective from the default view";
+  r.workload = workload;
+  r.what = what + ", " + std::to_string(size) + "^2 pixels, perspective from the default view";
   r.threads = ThreadsOr(2);
   r.unit = "Mpixels/s";
-  const frep::TapePtr tape = frep::Tape::compile(bundled::sphereGyroidField());
-  const frep::Box3 box{ { -5, -5, -5 }, { 5, 5, 5 } };
   const render::Camera camera =
     render::Camera::orbit(box, {}, render::Projection::Perspective, size, size);
   render::RayCastOptions options;
@@ -363,6 +363,22 @@ Result RenderSphereGyroid(int size)
   r.details["interval_evaluations_per_pixel"] = image.intervalEvaluations / r.work;
   r.details["point_evaluations_per_pixel"] = image.pointEvaluations / r.work;
   return r;
+}
+
+Result RenderSphereGyroid(int size)
+{
+  return RenderField("render-sphere-gyroid-" + std::to_string(size),
+    "ray casting of libfive's sphereGyroid over [-5,5]^3",
+    frep::Tape::compile(bundled::sphereGyroidField()), { { -5, -5, -5 }, { 5, 5, 5 } }, size);
+}
+
+Result RenderWalnut(int size)
+{
+  const frep::ModelInfo& walnut = frep::findModel("walnut");
+  return RenderField("render-walnut-" + std::to_string(size),
+    "ray casting of the bundled walnut (shell and kernel) over its bounds",
+    frep::Tape::compile(walnut.build().geometry().function()), { walnut.boundsLo, walnut.boundsHi },
+    size);
 }
 
 Result Flower(int divisions)
@@ -634,6 +650,10 @@ int BenchCommand::run()
   if (Selected(renderGyroid))
   {
     report(RenderSphereGyroid(renderSize));
+  }
+  if (Selected("render-walnut-" + std::to_string(renderSize)))
+  {
+    report(RenderWalnut(renderSize));
   }
   const int flowerDivisions = Options.Quick ? 64 : 256;
   if (Selected("flower-" + std::to_string(flowerDivisions)))
