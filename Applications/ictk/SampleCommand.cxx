@@ -53,6 +53,10 @@ public:
       throw UserError("--surface: '" + o.Surface + "' is not a " + SurfaceFormats + " file");
     }
     const GridPlan plan = PlanGrid(o, o.Double ? sizeof(double) : sizeof(float));
+    if (!o.Surface.empty())
+    {
+      CheckSurfaceGrid(plan, o.Surface, "--surface");
+    }
     // Fail on an unwritable destination before spending time on sampling.
     InterruptScope interrupts;
     AtomicOutput volumeFile(o.Output);
@@ -103,8 +107,8 @@ public:
       const auto t2 = std::chrono::steady_clock::now();
       vtkSmartPointer<vtkPolyData> surface = ExtractSurface(image, plan, messages);
       WriteSurface(surface, *surfaceFile, o.Surface, messages);
-      std::cout << "wrote " << o.Surface << " (" << surface->GetNumberOfPoints() << " points, "
-                << surface->GetNumberOfPolys() << " triangles) in " << Seconds(t2) << " s\n";
+      std::cout << "wrote " << o.Surface << " (" << SurfaceSummary(surface) << ") in "
+                << Seconds(t2) << " s\n";
     }
     return 0;
   }

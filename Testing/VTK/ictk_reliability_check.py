@@ -1,0 +1,190 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""What ictk survives (issue 19, docs/reliability.md), run as a user would.
+
+Usage: ictk_reliability_check.py --ictk PATH --work DIR CHECK [DATA]
+  reader-errors        broken voxel and mesh files in a complex: one diagnostic naming the file
+                       and what was wrong, exit 2, no VTK text (VTK's text with --verbose)
+  mesh-2d DATA         a 2D model (x[2]) meshed as its boundary curve; .stl refused with the why
+  determinism-COMMAND DATA   the same command on 1, 2 and 8 threads writes byte-identical files
+                       (COMMAND: sample, mesh, tetra, run, render)
+"""
+import filecmp
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ictk_cli_check import near, read_polydata, run  # noqa: E402
+
+# Text that only VTK's own reports carry: an object's address, the source line, the executive.
+VTK_TEXT = re.compile(r"0x[0-9a-f]+|ERROR: In |vtkXML|vtkExecutive|vtkInformation|returned failure")
+
+
+def write(path, data):
+    with open(path, "wb") as f:
+        f.write(data)
+
+
+def check_reader_errors(ictk, work):
+    """Each broken file referenced by a complex gives the diagnostic
+    'complex.json:L:C: error: cell 'scan': cannot read 'FILE': WHY' (with the source line and a
+    caret under it, as every model-file error), exit code 2, and none of VTK's own text."""
+    import vtk
+    sphere = os.path.join(work, "sphere.vti")
+    run(ictk, ["sample", "sphere", "-o", sphere, "--resolution", "16"])
+    with open(sphere, "rb") as f:
+        image = f.read()
+    surface = os.path.join(work, "sphere.vtp")
+    run(ictk, ["mesh", "sphere", "-o", surface, "--resolution", "16"])
+    with open(surface, "rb") as f:
+        polydata = f.read()
+    empty_image = vtk.vtkImageData()
+    empty_image.SetDimensions(3, 3, 3)
+    writer = vtk.vtkXMLImageDataWriter()
+    writer.SetFileName(os.path.join(work, "noarray.vti"))
+    writer.SetInputData(empty_image)
+    writer.Write()
+    write(os.path.join(work, "garbage.vti"), b"\x89 not XML at all \x00\x01\x02")
+    write(os.path.join(work, "empty.vti"), b"")
+    write(os.path.join(work, "polydata.vti"), polydata)
+    write(os.path.join(work, "cut.vti"), image[:1500])
+    write(os.path.join(work, "unclosed.vti"), b'<?xml version="1.0"?>\n<VTKFile type="ImageData">\n  <ImageData')
+    write(os.path.join(work, "text.mha"), b"hello")
+    write(os.path.join(work, "text.nii"), b"hello")
+    write(os.path.join(work, "text.nrrd"), b"hello")
+    write(os.path.join(work, "text.ply"), b"hello")
+    write(os.path.join(work, "text.stl"), b"hello\x00")
+    voxel = {
+        "garbage.vti": "cannot read '{}': not an XML file",
+        "empty.vti": "cannot read '{}': the file is empty",
+        "polydata.vti": "cannot read '{}': a VTK PolyData file, not ImageData",
+        "cut.vti": r"cannot read '{}': its data is cut short or corrupt \(Error reading extent 0 15 0 15 0 15 from piece 0\)",
+        "unclosed.vti": r"cannot read '{}': not well-formed XML \(line 3, column 3: unclosed token\)",
+        "noarray.vti": "'{}' has no point array",
+        "text.mha": "cannot read '{}': not a MetaImage file",
+        "text.nii": "cannot read '{}': not a NIfTI file",
+        "text.nrrd": "cannot read '{}': not a NRRD file",
+    }
+    mesh = {
+        "text.ply": "cannot read '{}': not a PLY file",
+        "text.stl": "cannot read '{}': Premature EOF while reading header.",
+        "garbage.vti": "'{}': explicit cells are read from .vtp, .vtu, .stl, .ply or .obj files",
+    }
+    cases = [("V", 3, name, why) for name, why in voxel.items()] + \
+            [("B", 2, name, why) for name, why in mesh.items()]
+    for kind, dimension, name, why in cases:
+        complex_path = os.path.join(work, "complex.json")
+        with open(complex_path, "w") as f:
+            f.write('{ "cells": [\n  { "name": "scan", "kind": "%s", "dimension": %d, "file": "%s" } ] }\n'
+                    % (kind, dimension, name))
+        target = os.path.join(work, name)
+        commands = [["info", complex_path]]
+        if name == "garbage.vti" and kind == "V":
+            commands.append(["mesh", complex_path, "-o", os.path.join(work, "x.vtpc")])
+        for command in commands:
+            p = run(ictk, command, check=False)
+            lines = p.stderr.splitlines()
+            expected = re.escape(complex_path + ":2:13: error: cell 'scan': ") + why.format(re.escape(target))
+            if p.returncode != 2 or not lines or not re.fullmatch(expected, lines[0]):
+                sys.exit(f"FAIL: ictk {' '.join(command)} ({name}): exit {p.returncode}, stderr:\n{p.stderr}\n"
+                         f"expected the first line to be {expected!r}")
+            if len(lines) != 3 or lines[2].strip() != "^" or VTK_TEXT.search(p.stderr + p.stdout):
+                sys.exit(f"FAIL: {name}: more than the diagnostic, or VTK's text:\n{p.stderr}")
+            if os.path.exists(os.path.join(work, "x.vtpc")) or os.path.exists(os.path.join(work, "x")):
+                sys.exit(f"FAIL: {name}: output written despite the error")
+    # --verbose adds VTK's own reports, after or before the same diagnostic.
+    with open(complex_path, "w") as f:
+        f.write('{ "cells": [\n  { "name": "scan", "kind": "V", "dimension": 3, "file": "garbage.vti" } ] }\n')
+    p = run(ictk, ["info", complex_path, "--verbose"], check=False)
+    if p.returncode != 2 or "vtkXMLDataParser" not in p.stderr or "not an XML file" not in p.stderr:
+        sys.exit(f"FAIL: --verbose does not show VTK's report:\n{p.stderr}")
+
+
+def check_mesh_2d(ictk, work, data):
+    """A HyperFun x[2] model (disk2d: the disk of radius 2 minus the disk of radius 0.5 at (1, 0))
+    meshed: its boundary curve, closed, on both circles; formats without curves refused."""
+    model = os.path.join(data, "Models", "disk2d.hf")
+    vtp = os.path.join(work, "disk.vtp")
+    p = run(ictk, ["mesh", model, "-o", vtp, "--resolution", "96"])
+    if not re.search(r"\(\d+ points, \d+ line segments from a 96 x 96 x 1 grid\)", p.stdout) or p.stderr.count("error"):
+        sys.exit(f"FAIL: mesh of a 2D model:\n{p.stdout}\n{p.stderr}")
+    curve = read_polydata(vtp)
+    if curve.GetNumberOfPolys() != 0 or curve.GetNumberOfLines() < 100:
+        sys.exit(f"FAIL: {curve.GetNumberOfLines()} lines, {curve.GetNumberOfPolys()} polygons")
+    # Closed: every point ends exactly two segments.
+    uses = [0] * curve.GetNumberOfPoints()
+    lines = curve.GetLines()
+    ids = vtk_id_list()
+    lines.InitTraversal()
+    while lines.GetNextCell(ids):
+        for k in range(ids.GetNumberOfIds()):
+            uses[ids.GetId(k)] += 1
+    if set(uses) != {2}:
+        sys.exit(f"FAIL: the curve is not closed: point uses {sorted(set(uses))}")
+    spacing = 4.0 / 95  # the model's bounds are [-2, 2]^2 (interval bounds of the disk)
+    outer = inner = 0
+    for i in range(curve.GetNumberOfPoints()):
+        x, y, z = curve.GetPoint(i)
+        near(z, 0.0, 0.0, "z of the 2D curve")
+        r_outer, r_inner = math.hypot(x, y) - 2, math.hypot(x - 1, y) - 0.5
+        if abs(r_outer) < abs(r_inner):
+            outer += 1
+            near(r_outer, 0.0, 0.1 * spacing, f"radius of the outer circle at {(x, y)}")
+        else:
+            inner += 1
+            near(r_inner, 0.0, 0.1 * spacing, f"radius of the inner circle at {(x, y)}")
+    if outer < 100 or inner < 20:
+        sys.exit(f"FAIL: {outer} points on the outer circle, {inner} on the inner one")
+    run(ictk, ["mesh", model, "-o", os.path.join(work, "disk.obj"), "--resolution", "32"])
+    with open(os.path.join(work, "disk.obj")) as f:
+        if not any(l.startswith("l ") for l in f):
+            sys.exit("FAIL: the .obj curve has no 'l' lines")
+    # The x[2] model as .stl: refused before any work, saying why and how.
+    stl = os.path.join(work, "x.stl")
+    p = run(ictk, ["mesh", model, "-o", stl], check=False)
+    want = (f"ictk: error: -o: 'disk2d' is sampled on a flat 128 x 128 x 1 grid (a 2D model): its boundary "
+            f"f = 0 is a curve, written as .vtp or .obj, not '{stl}'")
+    if p.returncode != 2 or p.stderr.strip().splitlines() != [want] or os.path.exists(stl):
+        sys.exit(f"FAIL: 2D model as .stl: exit {p.returncode}, stderr:\n{p.stderr}\nexpected {want!r}")
+    # A grid flat along two axes has no surface at all.
+    p = run(ictk, ["mesh", "sphere", "-o", os.path.join(work, "x.vtp"), "--dims", "20,1,1"], check=False)
+    want = ("ictk: error: -o: a 20 x 1 x 1 grid has no surface f = 0 to extract; give two or three axes "
+            "at least 2 points (--dims, --bounds)")
+    if p.returncode != 2 or p.stderr.strip().splitlines() != [want]:
+        sys.exit(f"FAIL: a 1D grid: exit {p.returncode}, stderr:\n{p.stderr}")
+    # A 3D model cut by a flat box along x: the unit circle in the plane x = 0.
+    p = run(ictk, ["mesh", "sphere", "-o", vtp, "--resolution", "40", "--bounds=0,0,-1.2,1.2,-1.2,1.2"])
+    curve = read_polydata(vtp)
+    for i in range(curve.GetNumberOfPoints()):
+        x, y, z = curve.GetPoint(i)
+        near(x, 0.0, 0.0, "x of the section")
+        near(math.hypot(y, z), 1.0, 0.01, "radius of the section")
+
+
+def vtk_id_list():
+    import vtk
+    return vtk.vtkIdList()
+
+
+def main():
+    argv = sys.argv[1:]
+    if len(argv) < 5 or argv[0] != "--ictk" or argv[2] != "--work":
+        sys.exit(__doc__)
+    ictk, work, check, rest = argv[1], argv[3], argv[4], argv[5:]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    if check == "reader-errors":
+        check_reader_errors(ictk, work)
+    elif check == "mesh-2d":
+        check_mesh_2d(ictk, work, rest[0])
+    else:
+        sys.exit(f"unknown check {check!r}")
+    print("OK")
+
+
+if __name__ == "__main__":
+    main()
