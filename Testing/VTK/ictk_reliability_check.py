@@ -6,8 +6,9 @@ Usage: ictk_reliability_check.py --ictk PATH --work DIR CHECK [DATA]
   reader-errors        broken voxel and mesh files in a complex: one diagnostic naming the file
                        and what was wrong, exit 2, no VTK text (VTK's text with --verbose)
   mesh-2d DATA         a 2D model (x[2]) meshed as its boundary curve; .stl refused with the why
-  determinism-COMMAND DATA   the same command on 1, 2 and 8 threads writes byte-identical files
-                       (COMMAND: sample, mesh, tetra, run, render)
+  determinism-COMMAND DATA [BACKENDS...]   the same command on 1, 2 and 8 threads writes
+                       byte-identical files (COMMAND: sample, mesh, tetra, run, render; tetra with
+                       each backend named)
 """
 import filecmp
 import math
@@ -165,6 +166,62 @@ def check_mesh_2d(ictk, work, data):
         near(math.hypot(y, z), 1.0, 0.01, "radius of the section")
 
 
+def determinism_commands(data):
+    """The commands of each determinism check, writing into the current folder ({threads} is the
+    thread count): every command that writes a file, with its outputs."""
+    models = os.path.join(data, "Models")
+    flower = os.path.join(models, "flower", "flower.json")
+    bar = os.path.join(models, "bar", "two_material_bar.json")
+    return {
+        "sample": [["sample", "walnut", "-o", "walnut.vti", "--resolution", "40", "--surface", "walnut.vtp"],
+                   ["sample", "morph", "-o", "morph.vti", "--resolution", "24", "--time", "0.5", "--double"]],
+        "mesh": [["mesh", "walnut", "-o", "walnut.vtp", "--resolution", "48"],
+                 ["mesh", os.path.join(models, "twisted_torus.hf"), "-o", "torus.ply", "--resolution", "40"],
+                 ["mesh", os.path.join(models, "disk2d.hf"), "-o", "disk.vtp"],
+                 ["mesh", flower, "-o", "flower-c.vtpc"],
+                 ["mesh", flower, "-o", "flower-m.vtm", "--size", "0.05", "--volume-resolution", "12"]],
+        "tetra": [["tetra", bar, "-o", f"bar-{backend}.{ext}", "--backend", backend, "--size", "0.05",
+                   "--deterministic"] for backend in ("tetgen", "cgal") for ext in ("vtu", "inp")],
+        "run": [["run", os.path.join(models, "icm", "ch5_1_disk_rectangle.icm"), "--frames", "0:2:0.5",
+                 "-o", "disk.pvd", "--trace", "disk.jsonl"]],
+        "render": [["render", "walnut", "-o", "walnut.png", "--size", "96,64", "--depth", "walnut-depth.vti"],
+                   ["render", os.path.join(models, "twisted_torus.hf"), "-o", "torus.png", "--size", "64,64",
+                    "--view", "30,40", "--projection", "orthographic"]],
+    }
+
+
+def tree(folder):
+    """Every file under `folder`, relative to it."""
+    return sorted(os.path.relpath(os.path.join(root, name), folder)
+                  for root, _, names in os.walk(folder) for name in names)
+
+
+def check_determinism(ictk, work, command, data, backends):
+    """The same command on 1, 2 and 8 threads writes the same files, byte for byte (tetra: with
+    each of the built `backends`)."""
+    commands = determinism_commands(data)[command]
+    if command == "tetra":
+        commands = [c for c in commands if c[c.index("--backend") + 1] in backends]
+    outputs = {}
+    for threads in (1, 2, 8):
+        folder = os.path.join(work, f"threads-{threads}")
+        os.makedirs(folder)
+        for args in commands:
+            args = [os.path.join(folder, a) if i > 0 and args[i - 1] in ("-o", "--surface", "--trace", "--depth")
+                    else a for i, a in enumerate(args)]
+            run(ictk, args + ["--threads", str(threads)])
+        outputs[threads] = tree(folder)
+    if not outputs[1] or outputs[2] != outputs[1] or outputs[8] != outputs[1]:
+        sys.exit(f"FAIL: the files differ by thread count: {outputs}")
+    for threads in (2, 8):
+        for name in outputs[1]:
+            a = os.path.join(work, "threads-1", name)
+            b = os.path.join(work, f"threads-{threads}", name)
+            if not filecmp.cmp(a, b, shallow=False):
+                sys.exit(f"FAIL: {name} differs between 1 and {threads} threads")
+    print(f"{len(outputs[1])} files identical on 1, 2 and 8 threads")
+
+
 def vtk_id_list():
     import vtk
     return vtk.vtkIdList()
@@ -181,6 +238,8 @@ def main():
         check_reader_errors(ictk, work)
     elif check == "mesh-2d":
         check_mesh_2d(ictk, work, rest[0])
+    elif check.startswith("determinism-"):
+        check_determinism(ictk, work, check[len("determinism-"):], rest[0], rest[1:])
     else:
         sys.exit(f"unknown check {check!r}")
     print("OK")
