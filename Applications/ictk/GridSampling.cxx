@@ -372,7 +372,9 @@ void WriteSurface(vtkPolyData* surface, AtomicOutput& file, const std::string& p
   ictkCaptureOutputWindow* messages)
 {
   // Every writer is given the temporary path, and reports failure through Write() and its error
-  // code (vtkXMLWriter is not a vtkWriter, so each kind is driven on its own).
+  // code (vtkXMLWriter is not a vtkWriter, so each kind is driven on its own); the .vtp is made in
+  // memory (WriteXml). vtkPLYWriter and vtkOBJWriter ignore their stream's errors: Commit checks
+  // that the file was not cut short.
   auto run = [&](auto* writer)
   {
     writer->SetInputData(surface);
@@ -386,7 +388,8 @@ void WriteSurface(vtkPolyData* surface, AtomicOutput& file, const std::string& p
     vtkNew<vtkXMLPolyDataWriter> xml;
     xml->SetDataModeToAppended();
     xml->EncodeAppendedDataOff();
-    written = run(xml.Get());
+    WriteXml(xml, surface, file);
+    written = true;
   }
   else if (HasExtension(path, ".stl"))
   {

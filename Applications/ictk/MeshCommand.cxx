@@ -109,8 +109,7 @@ private:
     if (messages->Errors.size() > errorsBefore ||
       source->GetOutput()->GetNumberOfPartitionedDataSets() == 0)
     {
-      const std::string failure =
-        messages->Errors.size() > errorsBefore ? messages->Errors[errorsBefore] : std::string();
+      const std::string failure = messages->FirstCause(errorsBefore);
       throw UserError("cannot discretise '" + o.Model + "'" +
         (failure.empty() ? std::string() : ": " + failure) + "; nothing written");
     }

@@ -28,6 +28,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <type_traits>
 
 namespace ictk::cli
 {
@@ -48,9 +49,16 @@ void Write(Writer* writer, vtkImageData* image, AtomicOutput& file, const std::s
 {
   ictkCaptureOutputWindow* messages = CaptureVtkMessages();
   const std::size_t errorsBefore = messages->Errors.size();
-  writer->SetInputData(image);
-  writer->SetFileName(file.Path().c_str());
-  writer->Write();
+  if constexpr (std::is_base_of_v<vtkXMLWriter, Writer>)
+  {
+    WriteXml(writer, image, file);
+  }
+  else
+  {
+    writer->SetInputData(image);
+    writer->SetFileName(file.Path().c_str());
+    writer->Write();
+  }
   ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + path + "'");
   if (writer->GetErrorCode() != 0)
   {

@@ -230,7 +230,7 @@ int RunModel(const RunModelOptions& o)
   const std::size_t errorsBefore = messages->Errors.size();
   auto failure = [&]
   {
-    return messages->Errors.size() > errorsBefore ? messages->Errors[errorsBefore] : std::string();
+    return messages->FirstCause(errorsBefore);
   };
   // A model error in the front ends' form, with the source line and a caret.
   auto rethrowModelError = [&]

@@ -78,16 +78,10 @@ public:
 
     const auto t1 = std::chrono::steady_clock::now();
     vtkNew<vtkXMLImageDataWriter> writer;
-    writer->SetInputData(image);
-    writer->SetFileName(volumeFile.Path().c_str());
     writer->SetDataModeToAppended();
     writer->EncodeAppendedDataOff();
-    std::size_t errorsBefore = messages->Errors.size();
-    if (writer->Write() != 1 || writer->GetErrorCode() != 0)
-    {
-      ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
-      throw UserError("cannot write '" + o.Output + "'");
-    }
+    const std::size_t errorsBefore = messages->Errors.size();
+    WriteXml(writer, image, volumeFile);
     ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
     volumeFile.Commit();
     const double writeSeconds = Seconds(t1);

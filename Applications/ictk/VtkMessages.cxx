@@ -43,12 +43,23 @@ ictkCaptureOutputWindow* CaptureVtkMessages(bool verbose)
   return window;
 }
 
+std::string ictkCaptureOutputWindow::FirstCause(std::size_t before) const
+{
+  if (this->Errors.size() <= before)
+  {
+    return {};
+  }
+  const std::string cause = ictk::vtk::firstCause(std::vector<std::string>(
+    this->Errors.begin() + static_cast<std::ptrdiff_t>(before), this->Errors.end()));
+  return cause.empty() ? "VTK failed without saying why (--verbose shows its report)" : cause;
+}
+
 void ThrowIfVtkFailed(
   const ictkCaptureOutputWindow* window, std::size_t before, const std::string& what)
 {
   if (window->Errors.size() > before)
   {
-    throw UserError(what + ": " + window->Errors[before]);
+    throw UserError(what + ": " + window->FirstCause(before));
   }
 }
 

@@ -27,6 +27,10 @@ public:
   /// The messages alone ("ERROR: In file, line N\nClass (0x...): message" -> "message").
   std::vector<std::string> Errors;
   std::vector<std::string> Warnings;
+
+  /// What the errors recorded after the first `before` say went wrong (ictk::vtk::firstCause),
+  /// "" when there are none.
+  std::string FirstCause(std::size_t before) const;
 };
 
 /// Installs the capturing window (once) as VTK's output window and returns it. `verbose` (main's
@@ -34,8 +38,8 @@ public:
 /// that reach the window and those that ICTK's readers capture (ictkErrorCapture.h).
 ictkCaptureOutputWindow* CaptureVtkMessages(bool verbose = false);
 
-/// Throws a UserError "<what>: <message>" for the first VTK error recorded after the first
-/// `before` ones (take `before` from Errors.size() ahead of the work).
+/// Throws a UserError "<what>: <message>" when VTK errors were recorded after the first `before`
+/// ones (take `before` from Errors.size() ahead of the work), with the message of FirstCause.
 void ThrowIfVtkFailed(
   const ictkCaptureOutputWindow* window, std::size_t before, const std::string& what);
 

@@ -5,6 +5,7 @@
 Usage: ictk_reliability_check.py --ictk PATH --work DIR CHECK [DATA]
   reader-errors        broken voxel and mesh files in a complex: one diagnostic naming the file
                        and what was wrong, exit 2, no VTK text (VTK's text with --verbose)
+  faults DATA [tetgen]  writers past the file size limit (as a full disk) and in a read-only folder
   mesh-2d DATA         a 2D model (x[2]) meshed as its boundary curve; .stl refused with the why
   determinism-COMMAND DATA [BACKENDS...]   the same command on 1, 2 and 8 threads writes
                        byte-identical files (COMMAND: sample, mesh, tetra, run, render; tetra with
@@ -222,6 +223,70 @@ def check_determinism(ictk, work, command, data, backends):
     print(f"{len(outputs[1])} files identical on 1, 2 and 8 threads")
 
 
+def run_limited(ictk, args, file_size):
+    """ictk under a file size limit of `file_size` bytes (ulimit -f), with SIGXFSZ ignored as a
+    shell's `trap '' XFSZ` does, so that a write past it fails (EFBIG) as on a full disk (ENOSPC)."""
+    import resource
+    import signal
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (file_size, file_size))
+    return subprocess.run([ictk] + args, capture_output=True, text=True, timeout=100, preexec_fn=limit)
+
+
+def check_faults(ictk, work, data):
+    """Writers against a full disk (the file size limit) and a read-only folder: exit 2, one
+    'ictk: error: cannot write' line naming the output, nothing written, and the user's earlier
+    file of the same name untouched."""
+    models = os.path.join(data, "Models")
+    bar = os.path.join(models, "bar", "two_material_bar.json")
+    flower = os.path.join(models, "flower", "flower.json")
+    cases = [
+        (["sample", "walnut", "--resolution", "40", "-o"], "walnut.vti", "File too large"),
+        (["mesh", "walnut", "-o"], "walnut.vtp", "File too large"),
+        (["mesh", "walnut", "-o"], "walnut.stl", "Ran out of disk space"),
+        (["mesh", "walnut", "-o"], "walnut.ply", r"the file reached the file size limit \(ulimit -f\) of 4096 bytes"),
+        (["mesh", "walnut", "-o"], "walnut.obj", r"the file reached the file size limit \(ulimit -f\) of 4096 bytes"),
+        (["mesh", flower, "-o"], "flower.vtpc",
+         r"a piece may need up to \d+ bytes, over the file size limit \(ulimit -f\) of 4096 bytes"),
+        (["render", "walnut", "--size", "400,400", "-o"], "walnut.png", "Ran out of disk space"),
+        (["convert", "walnut"], "walnut.xml", "cannot write the temporary file: File too large"),
+    ]
+    if "tetgen" in sys.argv[6:]:
+        cases += [(["tetra", bar, "--backend", "tetgen", "--size", "0.05", "-o"], "bar.msh", "File too large")]
+    earlier = b"the user's earlier result"
+    for args, name, why in cases:
+        target = os.path.join(work, name)
+        write(target, earlier)
+        p = run_limited(ictk, args + [target], 4096)
+        lines = p.stderr.strip().splitlines()
+        verb = "save" if args[0] == "convert" else "write"
+        want = f"ictk: error: cannot {verb} '{re.escape(target)}': {why}(; nothing written)?"
+        if p.returncode != 2 or not lines or not re.fullmatch(want, lines[-1]) or VTK_TEXT.search(p.stderr):
+            sys.exit(f"FAIL: {name} past the file size limit: exit {p.returncode}, stderr:\n{p.stderr}\n"
+                     f"expected the last line to match {want!r}")
+        with open(target, "rb") as f:
+            if f.read() != earlier:
+                sys.exit(f"FAIL: {name}: the earlier file was changed by the failed write")
+        left = sorted(set(os.listdir(work)) - {n for _, n, _ in cases})
+        if left:
+            sys.exit(f"FAIL: {name}: files left behind: {left}")
+    # A read-only folder (as root, whom permissions do not stop, a folder of /proc).
+    folder = os.path.join(work, "read-only")
+    os.makedirs(folder)
+    os.chmod(folder, 0o555)
+    if os.geteuid() == 0:
+        folder = "/proc/self"
+    for args, name, _ in cases:
+        target = os.path.join(folder, name)
+        p = run(ictk, args + [target], check=False)
+        lines = p.stderr.strip().splitlines()
+        want = re.escape(f"ictk: error: cannot {'save' if args[0] == 'convert' else 'write'} '{target}'")
+        if p.returncode != 2 or len(lines) != 1 or not re.match(want, lines[0]):
+            sys.exit(f"FAIL: {name} in a read-only folder: exit {p.returncode}, stderr:\n{p.stderr}")
+
+
 def vtk_id_list():
     import vtk
     return vtk.vtkIdList()
@@ -238,6 +303,8 @@ def main():
         check_reader_errors(ictk, work)
     elif check == "mesh-2d":
         check_mesh_2d(ictk, work, rest[0])
+    elif check == "faults":
+        check_faults(ictk, work, rest[0])
     elif check.startswith("determinism-"):
         check_determinism(ictk, work, check[len("determinism-"):], rest[0], rest[1:])
     else:

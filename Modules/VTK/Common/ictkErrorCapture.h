@@ -44,6 +44,22 @@ inline std::string vtkMessageText(const char* text)
   return s;
 }
 
+/// The first of `errors` that says what went wrong, "" when none does: the executive's
+/// follow-up ("Algorithm X (0x...) returned failure for request: vtkInformation ...") only
+/// repeats that an algorithm failed, and a writer's "; deleting file: <path>" tail names the
+/// temporary file ICTK wrote through, which the user never sees.
+inline std::string firstCause(const std::vector<std::string>& errors)
+{
+  for (const std::string& e : errors)
+  {
+    if (e.find("returned failure for request") == std::string::npos)
+    {
+      return e.substr(0, e.find("; deleting file"));
+    }
+  }
+  return {};
+}
+
 /// The vtkLogger verbosity at which captured reports are logged: off by default, shown by
 /// `ictk --verbose` (VTK's pipeline traces, at VERBOSITY_TRACE, stay hidden).
 constexpr vtkLogger::Verbosity ReportVerbosity = vtkLogger::VERBOSITY_5;

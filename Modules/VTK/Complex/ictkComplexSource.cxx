@@ -137,14 +137,11 @@ std::string xmlFileType(const std::string& path)
 std::string readFailure(
   const std::string& path, const std::vector<std::string>& errors, const std::string& expected)
 {
-  const std::string failed = "returned failure for request";
-  auto message = std::find_if(errors.begin(), errors.end(),
-    [&](const std::string& e) { return e.find(failed) == std::string::npos; });
-  if (message == errors.end())
+  const std::string e = ictk::vtk::firstCause(errors);
+  if (e.empty())
   {
     return "VTK's reader failed without saying why";
   }
-  const std::string& e = *message;
   std::error_code ec;
   if (std::filesystem::file_size(path, ec) == 0 && !ec)
   {
