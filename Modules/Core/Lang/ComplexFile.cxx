@@ -65,12 +65,21 @@ public:
       throwIfFailed();
     }
     Complex k;
-    k.name = doc.value("name", std::string());
-    time_ = number(doc, "time", 0.0, "the time");
-    readLibrary(doc);
-    readAttributes(doc, k);
-    readCells(doc, k);
-    readRelations(doc, k);
+    try
+    {
+      k.name = doc.value("name", std::string());
+      time_ = number(doc, "time", 0.0, "the time");
+      readLibrary(doc);
+      readAttributes(doc, k);
+      readCells(doc, k);
+      readRelations(doc, k);
+    }
+    catch (const Json::exception& e)
+    {
+      // A value of another JSON type than the reading expects, where no check says so itself
+      // (found by FuzzComplexJson): reported at the element being read, reading stops.
+      report("a value has the wrong JSON type (" + jsonMessage(e.what()) + ")", current_);
+    }
     throwIfFailed();
     return k;
   }
@@ -80,8 +89,16 @@ private:
   {
     // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..." ->
     // the part after the position, which we print ourselves.
+    // Other exceptions: "[json.exception.type_error.306] cannot use value() with number" -> the
+    // part after the tag.
     const auto colon = what.find(": ");
-    return colon == std::string::npos ? what : what.substr(colon + 2);
+    if (colon != std::string::npos)
+    {
+      return what.substr(colon + 2);
+    }
+    const auto tag = what.find("] ");
+    return what.rfind("[json.exception.", 0) == 0 && tag != std::string::npos ? what.substr(tag + 2)
+                                                                              : what;
   }
 
   void report(const std::string& message, std::size_t offset = std::string::npos)
@@ -369,8 +386,16 @@ private:
     }
     for (const auto& [attribute, spec] : cell["attributes"].items())
     {
+      if (!spec.is_string() &&
+        !(spec.is_object() && spec.contains("function") && spec["function"].is_string()))
+      {
+        report("cell '" + c.name + "': attribute '" + attribute +
+            "' must name an attribute function: \"f\" or {\"function\": \"f\", \"priority\": p}",
+          current_);
+        continue;
+      }
       const std::string function =
-        spec.is_string() ? spec.get<std::string>() : spec.value("function", std::string());
+        spec.is_string() ? spec.get<std::string>() : spec["function"].get<std::string>();
       auto it = functions_.find(function);
       if (it == functions_.end())
       {
