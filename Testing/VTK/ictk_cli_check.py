@@ -799,14 +799,20 @@ def check_run_errors(ictk, work, data):
         sys.exit(f"FAIL: files left behind: {sorted(os.listdir(work))}")
 
 
-def main():
-    # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
+def parse_arguments(usage):
+    """--ictk PATH --work DIR CHECK [ARGS...] -> (ictk, work, check, args), with an empty work
+    folder. Parsed by hand: the patterns and ictk arguments start with "--" themselves."""
     argv = sys.argv[1:]
     if len(argv) < 5 or argv[0] != "--ictk" or argv[2] != "--work":
-        sys.exit(__doc__)
+        sys.exit(usage)
     ictk, work, check, rest = argv[1], argv[3], argv[4], argv[5:]
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
+    return ictk, work, check, rest
+
+
+def main():
+    ictk, work, check, rest = parse_arguments(__doc__)
     checks = {
         "models": check_models,
         "eval-json": check_eval_json,

@@ -15,12 +15,11 @@ import filecmp
 import math
 import os
 import re
-import shutil
 import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from ictk_cli_check import near, read_polydata, run  # noqa: E402
+from ictk_cli_check import near, parse_arguments, read_polydata, run  # noqa: E402
 
 # Text that only VTK's own reports carry: an object's address, the source line, the executive.
 VTK_TEXT = re.compile(r"0x[0-9a-f]+|ERROR: In |vtkXML|vtkExecutive|vtkInformation|returned failure")
@@ -293,12 +292,7 @@ def vtk_id_list():
 
 
 def main():
-    argv = sys.argv[1:]
-    if len(argv) < 5 or argv[0] != "--ictk" or argv[2] != "--work":
-        sys.exit(__doc__)
-    ictk, work, check, rest = argv[1], argv[3], argv[4], argv[5:]
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
+    ictk, work, check, rest = parse_arguments(__doc__)
     if check == "reader-errors":
         check_reader_errors(ictk, work)
     elif check == "mesh-2d":
