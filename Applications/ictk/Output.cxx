@@ -222,6 +222,19 @@ void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::st
 {
   const fs::path target = fs::absolute(output);
   CheckRoomForPieces(data, target.parent_path(), output);
+  // The pieces folder is named after the file's stem, so x.vtpc, x.vtm and x.pvd (ictk run's
+  // frames) would share it, and writing one would replace the pieces of another.
+  const fs::path folder = target.parent_path() / target.stem();
+  for (const char* other : { ".vtpc", ".vtm", ".pvd" })
+  {
+    const fs::path sibling = fs::path(target).replace_extension(other);
+    std::error_code ec;
+    if (sibling != target && fs::exists(sibling, ec) && fs::exists(folder, ec))
+    {
+      throw UserError("cannot write '" + output + "': the folder '" + folder.string() +
+        "' holds the pieces of '" + sibling.string() + "'; choose another name");
+    }
+  }
   const fs::path staging = target.parent_path() /
     (".ictk-" + target.filename().string() + "-" + std::to_string(::getpid()));
   fs::remove_all(staging);

@@ -384,7 +384,8 @@ def check_complex_flower(ictk, work, data):
     boundary = assembly.GetFirstNodeByPath("/flower/relations/boundary")
     if boundary < 0 or assembly.GetNumberOfChildren(boundary) != 8:
         sys.exit("FAIL: the assembly lacks /flower/relations/boundary with the 8 cells that have a boundary")
-    vtm = os.path.join(work, "flower.vtm")
+    # Another name than flower.vtpc's: both would keep their pieces in the folder 'flower'.
+    vtm = os.path.join(work, "blocks.vtm")
     # --size is the edge length in every command; --feature-size its older spelling.
     run(ictk, ["mesh", model, "-o", vtm, "--size", "0.03"])
     m = vtk.vtkXMLMultiBlockDataReader()

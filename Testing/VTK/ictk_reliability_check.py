@@ -271,6 +271,16 @@ def check_faults(ictk, work, data):
         left = sorted(set(os.listdir(work)) - {n for _, n, _ in cases})
         if left:
             sys.exit(f"FAIL: {name}: files left behind: {left}")
+    # Composites named alike share their pieces folder: flower.vtm next to flower.vtpc is refused
+    # rather than replacing the .vtpc's pieces.
+    run(ictk, ["mesh", flower, "-o", os.path.join(work, "flower.vtpc")])
+    pieces = tree(os.path.join(work, "flower"))
+    p = run(ictk, ["mesh", flower, "-o", os.path.join(work, "flower.vtm")], check=False)
+    want = (f"ictk: error: cannot write '{os.path.join(work, 'flower.vtm')}': the folder "
+            f"'{os.path.join(work, 'flower')}' holds the pieces of '{os.path.join(work, 'flower.vtpc')}'; "
+            "choose another name")
+    if p.returncode != 2 or p.stderr.strip().splitlines() != [want] or tree(os.path.join(work, "flower")) != pieces:
+        sys.exit(f"FAIL: a .vtm beside a .vtpc of the same name: exit {p.returncode}, stderr:\n{p.stderr}")
     # A read-only folder (as root, whom permissions do not stop, a folder of /proc).
     folder = os.path.join(work, "read-only")
     os.makedirs(folder)
