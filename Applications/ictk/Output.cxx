@@ -7,9 +7,8 @@
 #include <vtkDataObjectTree.h>
 #include <vtkDataObjectTreeIterator.h>
 #include <vtkSmartPointer.h>
-#include <vtkXMLWriterBase.h>
-
 #include <vtkXMLWriter.h>
+#include <vtkXMLWriterBase.h>
 
 #include <fcntl.h>
 #include <sys/resource.h>
