@@ -329,8 +329,12 @@ private:
   {
     if (doc.contains("attributes"))
     {
-      for (const auto& [name, spec] : doc["attributes"].items())
+      for (const auto& item : doc["attributes"].items())
       {
+        // Not a structured binding: the lambda below uses `spec`, which C++17 does not let a
+        // lambda capture from a binding (clang refuses it).
+        const std::string& name = item.key();
+        const Json& spec = item.value();
         current_ = locateKey(name);
         complex::AttributeDefaults d;
         d.components = spec.value("components", 1);
