@@ -3,6 +3,7 @@
 // readers: a cell's "file" is refused, or read as .vdb): any input must either read as a complex
 // or raise ParseError. Anything else escaping (another exception, a crash, a sanitizer report, a
 // timeout or running out of memory) is a bug.
+#include "FuzzLimits.h"
 #include "Lang/ComplexFile.h"
 
 #include <cstddef>
@@ -11,10 +12,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {
-  ictk::lang::Limits limits;
-  limits.maxLoopIterations = 100000;
-  limits.maxExpressionNodes = 200000;
-  limits.maxSyntaxNodes = 100000;
+  const ictk::lang::Limits limits = hyperFunFuzzLimits();
   const std::string text(reinterpret_cast<const char*>(data), size);
   try
   {
