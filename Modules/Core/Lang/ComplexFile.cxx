@@ -59,6 +59,19 @@ public:
       report(std::string("invalid JSON: ") + jsonMessage(e.what()), e.byte > 0 ? e.byte - 1 : 0);
       throwIfFailed();
     }
+    catch (const Json::out_of_range& e)
+    {
+      // A number beyond double's range ("number overflow parsing '1e99999'", found by
+      // FuzzComplexJson): reported at the number, which the message quotes.
+      const std::string what = jsonMessage(e.what());
+      const auto open = what.find('\'');
+      const auto close = open == std::string::npos ? open : what.find('\'', open + 1);
+      const std::size_t at = close == std::string::npos
+        ? std::string::npos
+        : text_.find(what.substr(open + 1, close - open - 1));
+      report("invalid JSON: " + what, at == std::string::npos ? 0 : at);
+      throwIfFailed();
+    }
     if (!doc.is_object())
     {
       report("the file must hold a JSON object with \"cells\"", 0);
