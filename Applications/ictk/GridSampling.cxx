@@ -14,12 +14,14 @@
 #include <vtkCommand.h>
 #include <vtkDataObject.h>
 #include <vtkFloatArray.h>
+#include <vtkFlyingEdges2D.h>
 #include <vtkFlyingEdges3D.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
 #include <vtkPLYWriter.h>
 #include <vtkPointData.h>
+#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSMPTools.h>
 #include <vtkSTLWriter.h>
@@ -251,26 +253,114 @@ vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, boo
   return image;
 }
 
+namespace
+{
+/// The number of axes of the planned grid that have a single point.
+int FlatAxes(const GridPlan& plan)
+{
+  return static_cast<int>(std::count(plan.Dims.begin(), plan.Dims.end(), std::int64_t{ 1 }));
+}
+
+std::string GridText(const GridPlan& plan)
+{
+  return std::to_string(plan.Dims[0]) + " x " + std::to_string(plan.Dims[1]) + " x " +
+    std::to_string(plan.Dims[2]);
+}
+} // namespace
+
+void CheckSurfaceGrid(const GridPlan& plan, const std::string& path, const std::string& option)
+{
+  const int flat = FlatAxes(plan);
+  if (flat >= 2)
+  {
+    throw UserError(option + ": a " + GridText(plan) +
+      " grid has no surface f = 0 to extract; give two or three axes at least 2 points (--dims, "
+      "--bounds)");
+  }
+  if (flat == 1 && !HasExtension(path, ".vtp") && !HasExtension(path, ".obj"))
+  {
+    throw UserError(option + ": '" + plan.Model.Name + "' is sampled on a flat " + GridText(plan) +
+      " grid (a 2D model): its boundary f = 0 is a curve, written as .vtp or .obj, not '" + path +
+      "'");
+  }
+}
+
+std::string SurfaceSummary(vtkPolyData* surface)
+{
+  const vtkIdType lines = surface->GetNumberOfLines();
+  return std::to_string(surface->GetNumberOfPoints()) + " points, " +
+    (lines > 0 && surface->GetNumberOfPolys() == 0
+        ? std::to_string(lines) + " line segments"
+        : std::to_string(surface->GetNumberOfPolys()) + " triangles");
+}
+
 vtkSmartPointer<vtkPolyData> ExtractSurface(
   vtkImageData* image, const GridPlan& plan, ictkCaptureOutputWindow* messages)
 {
-  vtkNew<vtkFlyingEdges3D> contour;
-  contour->SetInputData(image);
-  contour->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "f");
-  contour->SetValue(0, 0.0);
-  // f grows inwards, so the negated gradient Flying Edges uses for normals points outwards.
-  contour->ComputeNormalsOn();
-  contour->ComputeScalarsOff();
-  contour->InterpolateAttributesOff();
+  vtkSmartPointer<vtkPolyData> surface;
   const std::size_t errorsBefore = messages->Errors.size();
-  contour->Update();
-  ThrowIfVtkFailed(messages, errorsBefore, "surface extraction failed");
-  vtkSmartPointer<vtkPolyData> surface = contour->GetOutput();
+  if (FlatAxes(plan) == 1)
+  {
+    // A 2D model's boundary: the curve f = 0 in its plane, as line segments (Flying Edges 3D
+    // refuses a flat grid).
+    // Flying Edges 2D contours the XY plane only; a grid flat along x or y has the same point
+    // order as the XY image of its two other axes, so it is contoured as that and mapped back.
+    const int flat = static_cast<int>(
+      std::find(plan.Dims.begin(), plan.Dims.end(), std::int64_t{ 1 }) - plan.Dims.begin());
+    const int u = flat == 0 ? 1 : 0;
+    const int v = flat == 2 ? 1 : 2;
+    vtkNew<vtkImageData> plane;
+    plane->SetDimensions(image->GetDimensions()[u], image->GetDimensions()[v], 1);
+    plane->SetOrigin(image->GetOrigin()[u], image->GetOrigin()[v], 0);
+    plane->SetSpacing(image->GetSpacing()[u], image->GetSpacing()[v], 1);
+    plane->GetPointData()->SetScalars(image->GetPointData()->GetArray("f"));
+    vtkNew<vtkFlyingEdges2D> contour;
+    contour->SetInputData(plane);
+    contour->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "f");
+    contour->SetValue(0, 0.0);
+    contour->ComputeScalarsOff();
+    contour->Update();
+    ThrowIfVtkFailed(messages, errorsBefore, "curve extraction failed");
+    surface = contour->GetOutput();
+    vtkPoints* points = surface->GetPoints();
+    const double level = image->GetOrigin()[flat];
+    for (vtkIdType i = 0; points && i < points->GetNumberOfPoints(); ++i)
+    {
+      double p[3];
+      double q[3];
+      points->GetPoint(i, p);
+      q[u] = p[0];
+      q[v] = p[1];
+      q[flat] = level;
+      points->SetPoint(i, q);
+    }
+  }
+  else
+  {
+    vtkNew<vtkFlyingEdges3D> contour;
+    contour->SetInputData(image);
+    contour->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "f");
+    contour->SetValue(0, 0.0);
+    // f grows inwards, so the negated gradient Flying Edges uses for normals points outwards.
+    contour->ComputeNormalsOn();
+    contour->ComputeScalarsOff();
+    contour->InterpolateAttributesOff();
+    contour->Update();
+    ThrowIfVtkFailed(messages, errorsBefore, "surface extraction failed");
+    surface = contour->GetOutput();
+  }
   // Interpolating the grid's attribute arrays would mix the values on both sides of the
   // boundary (an attribute usually jumps there); evaluate them instead just inside the solid,
   // a thousandth of a grid step from each vertex against its outward normal.
   const auto& spacing = plan.Grid.spacing;
-  const double step = std::min({ spacing[0], spacing[1], spacing[2] });
+  double step = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (plan.Dims[a] > 1 && (step == 0 || spacing[a] < step))
+    {
+      step = spacing[a];
+    }
+  }
   AttachBoundaryAttributes(surface, plan.Model.Model, plan.Params, plan.Grid.time, 1e-3 * step);
   return surface;
 }
@@ -287,7 +377,9 @@ void WriteSurface(vtkPolyData* surface, AtomicOutput& file, const std::string& p
   ictkCaptureOutputWindow* messages)
 {
   // Every writer is given the temporary path, and reports failure through Write() and its error
-  // code (vtkXMLWriter is not a vtkWriter, so each kind is driven on its own).
+  // code (vtkXMLWriter is not a vtkWriter, so each kind is driven on its own); the .vtp is made in
+  // memory (WriteXml). vtkPLYWriter and vtkOBJWriter ignore their stream's errors: Commit checks
+  // that the file was not cut short.
   auto run = [&](auto* writer)
   {
     writer->SetInputData(surface);
@@ -301,7 +393,8 @@ void WriteSurface(vtkPolyData* surface, AtomicOutput& file, const std::string& p
     vtkNew<vtkXMLPolyDataWriter> xml;
     xml->SetDataModeToAppended();
     xml->EncodeAppendedDataOff();
-    written = run(xml.Get());
+    WriteXml(xml, surface, file);
+    written = true;
   }
   else if (HasExtension(path, ".stl"))
   {

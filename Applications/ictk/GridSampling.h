@@ -65,8 +65,15 @@ GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue);
 vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, bool asDouble,
   bool attributes, ictkCaptureOutputWindow* messages);
 
-/// The surface f = 0 of a sampled image, with outward normals and the model's attributes
-/// evaluated at its vertices.
+/// Checks, before any work, that the planned grid has a surface to write to `path` (given as
+/// `option`): a grid flat along one axis (a 2D model) has a boundary curve, written as .vtp or
+/// .obj (line segments); a flatter one has none.
+void CheckSurfaceGrid(const GridPlan& plan, const std::string& path, const std::string& option);
+/// "P points, T triangles", or "P points, L line segments" for a 2D model's boundary curve.
+std::string SurfaceSummary(vtkPolyData* surface);
+
+/// The surface f = 0 of a sampled image (the curve f = 0 of a flat one, CheckSurfaceGrid), with
+/// outward normals and the model's attributes evaluated at its vertices.
 vtkSmartPointer<vtkPolyData> ExtractSurface(
   vtkImageData* image, const GridPlan& plan, ictkCaptureOutputWindow* messages);
 

@@ -67,6 +67,7 @@ private:
       throw UserError("-o: '" + o.Output + "' is not a " + SurfaceFormats + " file");
     }
     const GridPlan plan = PlanGrid(o, sizeof(float));
+    CheckSurfaceGrid(plan, o.Output, "-o");
     InterruptScope interrupts;
     AtomicOutput file(o.Output);
     ictkCaptureOutputWindow* messages = CaptureVtkMessages();
@@ -80,10 +81,9 @@ private:
     }
     vtkSmartPointer<vtkPolyData> surface = ExtractSurface(image, plan, messages);
     WriteSurface(surface, file, o.Output, messages);
-    std::cout << "wrote " << o.Output << " (" << surface->GetNumberOfPoints() << " points, "
-              << surface->GetNumberOfPolys() << " triangles from a " << plan.Dims[0] << " x "
-              << plan.Dims[1] << " x " << plan.Dims[2] << " grid) in " << std::fixed
-              << std::setprecision(3) << Seconds(t0) << " s\n";
+    std::cout << "wrote " << o.Output << " (" << SurfaceSummary(surface) << " from a "
+              << plan.Dims[0] << " x " << plan.Dims[1] << " x " << plan.Dims[2] << " grid) in "
+              << std::fixed << std::setprecision(3) << Seconds(t0) << " s\n";
     return 0;
   }
 
@@ -109,8 +109,7 @@ private:
     if (messages->Errors.size() > errorsBefore ||
       source->GetOutput()->GetNumberOfPartitionedDataSets() == 0)
     {
-      const std::string failure =
-        messages->Errors.size() > errorsBefore ? messages->Errors[errorsBefore] : std::string();
+      const std::string failure = messages->FirstCause(errorsBefore);
       throw UserError("cannot discretise '" + o.Model + "'" +
         (failure.empty() ? std::string() : ": " + failure) + "; nothing written");
     }

@@ -6,15 +6,24 @@
 #include "ictkTetrahedralize.h"
 
 #include <vtkDataObject.h>
+#include <vtkDataObjectTree.h>
+#include <vtkDataObjectTreeIterator.h>
 #include <vtkNew.h>
+#include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridWriter.h>
+#include <vtkXMLWriter.h>
 #include <vtkXMLWriterBase.h>
 
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -71,8 +80,74 @@ AtomicOutput::~AtomicOutput()
   }
 }
 
+void AtomicOutput::Fail(const std::string& why) const
+{
+  throw UserError("cannot write '" + this->Destination + "': " + why + "; nothing written");
+}
+
+void AtomicOutput::Write(const std::string& bytes)
+{
+  const int fd = ::open(this->Temporary.c_str(), O_WRONLY | O_TRUNC);
+  if (fd < 0)
+  {
+    this->Fail(std::strerror(errno));
+  }
+  std::size_t done = 0;
+  while (done < bytes.size())
+  {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (n <= 0)
+    {
+      const int error = n < 0 ? errno : ENOSPC;
+      ::close(fd);
+      this->Fail(std::strerror(error));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::close(fd) != 0)
+  {
+    this->Fail(std::strerror(errno));
+  }
+}
+
 void AtomicOutput::Commit()
 {
+  const int fd = ::open(this->Temporary.c_str(), O_RDONLY);
+  struct stat st
+  {};
+  if (fd < 0 || ::fsync(fd) != 0 || ::fstat(fd, &st) != 0)
+  {
+    const int error = errno;
+    if (fd >= 0)
+    {
+      ::close(fd);
+    }
+    this->Fail(std::strerror(error));
+  }
+  // A write cut short leaves the file exactly at the size limit, or the disk without a free
+  // block; a file that happens to fill either exactly is refused too (it may be complete, but
+  // that cannot be told).
+  struct rlimit limit
+  {};
+  struct statvfs disk
+  {};
+  const bool full =
+    ::fstatvfs(fd, &disk) == 0 && (disk.f_bavail == 0 && (::geteuid() != 0 || disk.f_bfree == 0));
+  ::close(fd);
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+    static_cast<rlim_t>(st.st_size) >= limit.rlim_cur)
+  {
+    this->Fail("the file reached the file size limit (ulimit -f) of " +
+      std::to_string(limit.rlim_cur) + " bytes");
+  }
+  if (full)
+  {
+    this->Fail(std::strerror(ENOSPC));
+  }
   if (std::rename(this->Temporary.c_str(), this->Destination.c_str()) != 0)
   {
     throw UserError("cannot write '" + this->Destination + "': " + std::strerror(errno));
@@ -80,9 +155,90 @@ void AtomicOutput::Commit()
   this->Temporary.clear();
 }
 
+void WriteXml(vtkXMLWriter* writer, vtkDataObject* data, AtomicOutput& file)
+{
+  writer->SetInputDataObject(data);
+  writer->WriteToOutputStringOn();
+  if (writer->Write() != 1 || writer->GetErrorCode() != 0)
+  {
+    file.Fail("VTK's XML writer failed");
+  }
+  file.Write(writer->GetOutputString());
+}
+
+namespace
+{
+/// Refuses, before writing, a composite whose pieces may not fit: VTK's XML writers can crash
+/// when their stream fails mid-file, and the pieces are written by VTK's composite writers
+/// themselves. Every piece's size in memory bounds its compressed file: the largest against the
+/// file size limit (ulimit -f), their sum against the free space of the destination's disk.
+void CheckRoomForPieces(vtkDataObject* data, const fs::path& folder, const std::string& output)
+{
+  std::uint64_t total = 0;
+  std::uint64_t largest = 0;
+  auto add = [&](vtkDataObject* piece)
+  {
+    const std::uint64_t bytes = static_cast<std::uint64_t>(piece->GetActualMemorySize()) * 1024;
+    total += bytes;
+    largest = std::max(largest, bytes);
+  };
+  if (auto* tree = vtkDataObjectTree::SafeDownCast(data))
+  {
+    vtkSmartPointer<vtkDataObjectTreeIterator> it;
+    it.TakeReference(tree->NewTreeIterator());
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+    {
+      add(it->GetCurrentDataObject());
+    }
+  }
+  else
+  {
+    add(data);
+  }
+  auto megabytes = [](std::uint64_t bytes)
+  {
+    return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MB";
+  };
+  struct rlimit limit
+  {};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+    largest > limit.rlim_cur)
+  {
+    throw UserError("cannot write '" + output + "': a piece may need up to " +
+      std::to_string(largest) + " bytes, over the file size limit (ulimit -f) of " +
+      std::to_string(limit.rlim_cur) + " bytes; nothing written");
+  }
+  struct statvfs disk
+  {};
+  if (::statvfs(folder.c_str(), &disk) == 0)
+  {
+    const std::uint64_t free = static_cast<std::uint64_t>(disk.f_bavail) * disk.f_frsize;
+    if (total > free)
+    {
+      throw UserError("cannot write '" + output + "': its pieces may need up to " +
+        megabytes(total) + " and the disk has " + megabytes(free) + " free; nothing written");
+    }
+  }
+}
+} // namespace
+
 void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::string& output)
 {
   const fs::path target = fs::absolute(output);
+  CheckRoomForPieces(data, target.parent_path(), output);
+  // The pieces folder is named after the file's stem, so x.vtpc, x.vtm and x.pvd (ictk run's
+  // frames) would share it, and writing one would replace the pieces of another.
+  const fs::path folder = target.parent_path() / target.stem();
+  for (const char* other : { ".vtpc", ".vtm", ".pvd" })
+  {
+    const fs::path sibling = fs::path(target).replace_extension(other);
+    std::error_code ec;
+    if (sibling != target && fs::exists(sibling, ec) && fs::exists(folder, ec))
+    {
+      throw UserError("cannot write '" + output + "': the folder '" + folder.string() +
+        "' holds the pieces of '" + sibling.string() + "'; choose another name");
+    }
+  }
   const fs::path staging = target.parent_path() /
     (".ictk-" + target.filename().string() + "-" + std::to_string(::getpid()));
   fs::remove_all(staging);
@@ -126,13 +282,11 @@ void WriteUnstructuredGrid(
   vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination)
 {
   vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  writer->SetInputData(grid);
-  writer->SetFileName(file.Path().c_str());
   writer->SetDataModeToAppended();
-  if (writer->Write() != 1 || writer->GetErrorCode() != 0)
-  {
-    throw UserError("cannot write '" + destination + "'");
-  }
+  // In memory, then written and checked by AtomicOutput (a full disk fails cleanly); `destination`
+  // names the file in AtomicOutput's own messages.
+  (void)destination;
+  WriteXml(writer, grid, file);
   file.Commit();
 }
 

@@ -8,6 +8,7 @@
 
 class vtkDataObject;
 class vtkUnstructuredGrid;
+class vtkXMLWriter;
 class vtkXMLWriterBase;
 
 namespace ictk::mesh
@@ -31,12 +32,25 @@ public:
 
   /// The temporary file to write (it keeps the destination's extension).
   const std::string& Path() const { return this->Temporary; }
+  /// Writes `bytes` as the temporary file's content, checking every step (a full disk, the file
+  /// size limit) so that a failure is a UserError naming the destination.
+  void Write(const std::string& bytes);
+  /// Moves the temporary file onto the destination, once it is known to be complete: flushed to
+  /// the disk, and not cut short by a full disk or the file size limit (`ulimit -f`), which
+  /// writers that ignore their stream's errors (vtkOBJWriter) would not report.
   void Commit();
+  /// Throws the UserError "cannot write '<destination>': <why>; nothing written".
+  [[noreturn]] void Fail(const std::string& why) const;
 
 private:
   std::string Destination;
   std::string Temporary;
 };
+
+/// Runs a VTK XML writer into memory and writes its bytes with AtomicOutput::Write: VTK's XML
+/// writers can crash when their stream fails mid-file (a full disk), so they never write a file
+/// themselves.
+void WriteXml(vtkXMLWriter* writer, vtkDataObject* data, AtomicOutput& file);
 
 /// Writes a composite dataset file and its folder of pieces (named after the file's stem) into a
 /// temporary folder beside `output`, then moves both into place. An earlier pieces folder is

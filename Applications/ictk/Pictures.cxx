@@ -179,7 +179,9 @@ void WriteDepth(const PictureBuffers& picture, AtomicOutput& file, const std::st
   vtkNew<vtkXMLImageDataWriter> xml;
   xml->SetDataModeToAppended();
   xml->EncodeAppendedDataOff();
-  Run(xml.Get(), image, file.Path(), path);
+  // In memory, then written and checked by AtomicOutput (a full disk fails cleanly).
+  (void)path;
+  WriteXml(xml.Get(), image, file);
   file.Commit();
 }
 

@@ -210,7 +210,7 @@ int RunModel(const RunModelOptions& o)
   const std::size_t errorsBefore = messages->Errors.size();
   auto failure = [&]
   {
-    return messages->Errors.size() > errorsBefore ? messages->Errors[errorsBefore] : std::string();
+    return messages->FirstCause(errorsBefore);
   };
   // A model error in the front ends' form, with the source line and a caret.
   auto rethrowModelError = [&]
@@ -257,6 +257,17 @@ int RunModel(const RunModelOptions& o)
     std::ostringstream os;
     os << o.FramesOption << ": T0 = " << times.front() << " is before the model's start ("
        << source->GetStartTime() << ")";
+    throw std::invalid_argument(os.str());
+  }
+  // The engine's steps are set by --max-step: bounded as the frames are (ParseFrames).
+  constexpr double MaxEngineSteps = 1e7;
+  const double steps = (times.back() - source->GetStartTime()) / maxStep;
+  if (o.MaxStep > 0 && steps > MaxEngineSteps)
+  {
+    std::ostringstream os;
+    os << "--max-step: " << o.MaxStep << " from the model's start " << source->GetStartTime()
+       << " to " << times.back() << " gives " << steps << " engine steps, more than the limit of "
+       << static_cast<long long>(MaxEngineSteps) << " (a larger --max-step?)";
     throw std::invalid_argument(os.str());
   }
   double engineSeconds = Seconds(loadStart), meshSeconds = 0;

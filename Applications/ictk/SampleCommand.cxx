@@ -53,6 +53,10 @@ public:
       throw UserError("--surface: '" + o.Surface + "' is not a " + SurfaceFormats + " file");
     }
     const GridPlan plan = PlanGrid(o, o.Double ? sizeof(double) : sizeof(float));
+    if (!o.Surface.empty())
+    {
+      CheckSurfaceGrid(plan, o.Surface, "--surface");
+    }
     // Fail on an unwritable destination before spending time on sampling.
     InterruptScope interrupts;
     AtomicOutput volumeFile(o.Output);
@@ -74,16 +78,10 @@ public:
 
     const auto t1 = std::chrono::steady_clock::now();
     vtkNew<vtkXMLImageDataWriter> writer;
-    writer->SetInputData(image);
-    writer->SetFileName(volumeFile.Path().c_str());
     writer->SetDataModeToAppended();
     writer->EncodeAppendedDataOff();
-    std::size_t errorsBefore = messages->Errors.size();
-    if (writer->Write() != 1 || writer->GetErrorCode() != 0)
-    {
-      ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
-      throw UserError("cannot write '" + o.Output + "'");
-    }
+    const std::size_t errorsBefore = messages->Errors.size();
+    WriteXml(writer, image, volumeFile);
     ThrowIfVtkFailed(messages, errorsBefore, "cannot write '" + o.Output + "'");
     volumeFile.Commit();
     const double writeSeconds = Seconds(t1);
@@ -103,8 +101,8 @@ public:
       const auto t2 = std::chrono::steady_clock::now();
       vtkSmartPointer<vtkPolyData> surface = ExtractSurface(image, plan, messages);
       WriteSurface(surface, *surfaceFile, o.Surface, messages);
-      std::cout << "wrote " << o.Surface << " (" << surface->GetNumberOfPoints() << " points, "
-                << surface->GetNumberOfPolys() << " triangles) in " << Seconds(t2) << " s\n";
+      std::cout << "wrote " << o.Surface << " (" << SurfaceSummary(surface) << ") in "
+                << Seconds(t2) << " s\n";
     }
     return 0;
   }

@@ -3,66 +3,55 @@
 
 #include "Command.h"
 
+#include "ictkErrorCapture.h"
+
 #include <vtkLogger.h>
 #include <vtkObjectFactory.h>
 #include <vtkSmartPointer.h>
 
 namespace ictk::cli
 {
-namespace
-{
-
-/// "ERROR: In file, line N\nClass (0x...): message\n\n" -> "message".
-std::string Message(const char* text)
-{
-  std::string s = text ? text : "";
-  const auto header = s.find('\n');
-  if (s.rfind("ERROR: In ", 0) == 0 || s.rfind("Warning: In ", 0) == 0)
-  {
-    s = header == std::string::npos ? s : s.substr(header + 1);
-  }
-  const auto object = s.find("): ");
-  if (object != std::string::npos && s.find(" (") < object)
-  {
-    s = s.substr(object + 3);
-  }
-  while (!s.empty() && (s.back() == '\n' || s.back() == ' '))
-  {
-    s.pop_back();
-  }
-  return s;
-}
-
-} // namespace
 
 vtkStandardNewMacro(ictkCaptureOutputWindow);
 
 void ictkCaptureOutputWindow::DisplayErrorText(const char* text)
 {
-  this->Errors.push_back(Message(text));
+  this->Errors.push_back(ictk::vtk::vtkMessageText(text));
 }
 
 void ictkCaptureOutputWindow::DisplayWarningText(const char* text)
 {
-  this->Warnings.push_back(Message(text));
+  this->Warnings.push_back(ictk::vtk::vtkMessageText(text));
 }
 
 void ictkCaptureOutputWindow::DisplayGenericWarningText(const char* text)
 {
-  this->Warnings.push_back(Message(text));
+  this->Warnings.push_back(ictk::vtk::vtkMessageText(text));
 }
 
-ictkCaptureOutputWindow* CaptureVtkMessages()
+ictkCaptureOutputWindow* CaptureVtkMessages(bool verbose)
 {
   static vtkSmartPointer<ictkCaptureOutputWindow> window;
   if (!window)
   {
     window = vtkSmartPointer<ictkCaptureOutputWindow>::New();
     vtkOutputWindow::SetInstance(window);
-    // VTK >= 9.1 also logs every error through vtkLogger to stderr, besides the output window.
-    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+    // VTK >= 9.1 also logs every error through vtkLogger to stderr, besides the output window:
+    // that log is VTK's text, shown only when asked for.
+    vtkLogger::SetStderrVerbosity(verbose ? ictk::vtk::ReportVerbosity : vtkLogger::VERBOSITY_OFF);
   }
   return window;
+}
+
+std::string ictkCaptureOutputWindow::FirstCause(std::size_t before) const
+{
+  if (this->Errors.size() <= before)
+  {
+    return {};
+  }
+  const std::string cause = ictk::vtk::firstCause(std::vector<std::string>(
+    this->Errors.begin() + static_cast<std::ptrdiff_t>(before), this->Errors.end()));
+  return cause.empty() ? "VTK failed without saying why (--verbose shows its report)" : cause;
 }
 
 void ThrowIfVtkFailed(
@@ -70,7 +59,7 @@ void ThrowIfVtkFailed(
 {
   if (window->Errors.size() > before)
   {
-    throw UserError(what + ": " + window->Errors[before]);
+    throw UserError(what + ": " + window->FirstCause(before));
   }
 }
 

@@ -14,6 +14,7 @@
 // diagnostics are printed as they are); nothing is left half-written (Output.h).
 
 #include "Command.h"
+#include "VtkMessages.h"
 
 #include "Lang/Diagnostics.h"
 
@@ -38,6 +39,11 @@ int Run(int argc, char** argv)
   CLI::App app{ "ICTK: Implicit Complex ToolKit command-line tool", "ictk" };
   app.set_version_flag("--version", "ictk 0.1.0");
   app.require_subcommand(1);
+  // VTK's own error reports are turned into ICTK's one-line errors (VtkMessages.h); --verbose
+  // shows them as VTK wrote them. Given before or after the subcommand (fallthrough).
+  bool verbose = false;
+  app.add_flag("--verbose", verbose, "Also print VTK's own error and warning reports");
+  app.fallthrough();
 
   // In the order `ictk --help` lists them.
   std::vector<std::unique_ptr<Command>> commands;
@@ -81,6 +87,7 @@ int Run(int argc, char** argv)
     throw UserError(std::string(e.what()) + " (see ictk --help)");
   }
 
+  CaptureVtkMessages(verbose);
   for (std::size_t i = 0; i < commands.size(); ++i)
   {
     if (*subcommands[i])

@@ -236,6 +236,34 @@ TEST(ComplexFile, ErrorsNameFileLineAndCell)
   EXPECT_THROW(lang::readComplexFile("/nonexistent/x.json"), lang::ParseError);
 }
 
+// Found by FuzzComplexJson (issue 19): a value of another JSON type than expected, or a number
+// beyond double's range, escaped the reader as nlohmann's type_error or out_of_range; both are
+// diagnostics at their place.
+TEST(ComplexFile, ValuesOfTheWrongJsonTypeAreDiagnostics)
+{
+  auto message = [](const std::string& text)
+  {
+    try
+    {
+      lang::readComplexJson(text, "types.json");
+    }
+    catch (const lang::ParseError& e)
+    {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(message(R"({ "cells": [ { "name": "c", "kind": "F", "dimension": 3,
+    "inside": ["1"], "bounds": [[0, 0, 0], [1, 1, 1]], "attributes": { "density": 2.5 } } ] })"),
+    HasSubstr("types.json:1:24: error: cell 'c': attribute 'density' must name an attribute "
+              "function"));
+  EXPECT_THAT(message("{ \"cells\": [ 1e99999 ] }"),
+    HasSubstr("types.json:1:14: error: invalid JSON: number overflow parsing '1e99999'"));
+  EXPECT_THAT(message(R"({ "name": 5, "cells": [] })"),
+    HasSubstr("types.json: error: a value has the wrong JSON type (type must be string, but is "
+              "number)"));
+}
+
 TEST(MarchingTetrahedra, SphereSurfaceWithinTolerance)
 {
   // Marching tetrahedra with vertices refined onto f = 0: vertices within 1e-6 of the sphere;

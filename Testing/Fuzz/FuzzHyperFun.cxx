@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // libFuzzer target: any input must either compile or raise ParseError. Anything else escaping
 // (another exception, a crash, a sanitizer report, a timeout or running out of memory) is a bug.
+#include "FuzzLimits.h"
 #include "Lang/HyperFun.h"
 
 #include <cstddef>
@@ -9,11 +10,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {
-  ictk::lang::Limits limits;
-  // Small budgets keep every run fast; the limits themselves are what is being exercised.
-  limits.maxLoopIterations = 100000;
-  limits.maxExpressionNodes = 200000;
-  limits.maxSyntaxNodes = 100000;
+  const ictk::lang::Limits limits = hyperFunFuzzLimits();
   const std::string text(reinterpret_cast<const char*>(data), size);
   try
   {

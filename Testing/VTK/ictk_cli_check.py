@@ -386,7 +386,8 @@ def check_complex_flower(ictk, work, data):
     boundary = assembly.GetFirstNodeByPath("/flower/relations/boundary")
     if boundary < 0 or assembly.GetNumberOfChildren(boundary) != 8:
         sys.exit("FAIL: the assembly lacks /flower/relations/boundary with the 8 cells that have a boundary")
-    vtm = os.path.join(work, "flower.vtm")
+    # Another name than flower.vtpc's: both would keep their pieces in the folder 'flower'.
+    vtm = os.path.join(work, "blocks.vtm")
     # --size is the edge length in every command; --feature-size its older spelling.
     run(ictk, ["mesh", model, "-o", vtm, "--size", "0.03"])
     m = vtk.vtkXMLMultiBlockDataReader()
@@ -948,14 +949,20 @@ def check_study(ictk, work, data):
             shell_radius=2.6)
 
 
-def main():
-    # Parsed by hand: the patterns and ictk arguments start with "--" themselves.
+def parse_arguments(usage):
+    """--ictk PATH --work DIR CHECK [ARGS...] -> (ictk, work, check, args), with an empty work
+    folder. Parsed by hand: the patterns and ictk arguments start with "--" themselves."""
     argv = sys.argv[1:]
     if len(argv) < 5 or argv[0] != "--ictk" or argv[2] != "--work":
-        sys.exit(__doc__)
+        sys.exit(usage)
     ictk, work, check, rest = argv[1], argv[3], argv[4], argv[5:]
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
+    return ictk, work, check, rest
+
+
+def main():
+    ictk, work, check, rest = parse_arguments(__doc__)
     checks = {
         "models": check_models,
         "eval-json": check_eval_json,

@@ -166,7 +166,7 @@ void appendUnboundAttributes(
     for (const auto& [name, defaults] : complex.attributes())
     {
       const bool bound = std::any_of(c.attributes.begin(), c.attributes.end(),
-        [&](const AttributeBinding& b) { return b.attribute == name; });
+        [&name = name](const AttributeBinding& b) { return b.attribute == name; });
       if (bound)
       {
         continue;

@@ -59,18 +59,40 @@ public:
       report(std::string("invalid JSON: ") + jsonMessage(e.what()), e.byte > 0 ? e.byte - 1 : 0);
       throwIfFailed();
     }
+    catch (const Json::out_of_range& e)
+    {
+      // A number beyond double's range ("number overflow parsing '1e99999'", found by
+      // FuzzComplexJson): reported at the number, which the message quotes.
+      const std::string what = jsonMessage(e.what());
+      const auto open = what.find('\'');
+      const auto close = open == std::string::npos ? open : what.find('\'', open + 1);
+      const std::size_t at = close == std::string::npos
+        ? std::string::npos
+        : text_.find(what.substr(open + 1, close - open - 1));
+      report("invalid JSON: " + what, at == std::string::npos ? 0 : at);
+      throwIfFailed();
+    }
     if (!doc.is_object())
     {
       report("the file must hold a JSON object with \"cells\"", 0);
       throwIfFailed();
     }
     Complex k;
-    k.name = doc.value("name", std::string());
-    time_ = number(doc, "time", 0.0, "the time");
-    readLibrary(doc);
-    readAttributes(doc, k);
-    readCells(doc, k);
-    readRelations(doc, k);
+    try
+    {
+      k.name = doc.value("name", std::string());
+      time_ = number(doc, "time", 0.0, "the time");
+      readLibrary(doc);
+      readAttributes(doc, k);
+      readCells(doc, k);
+      readRelations(doc, k);
+    }
+    catch (const Json::exception& e)
+    {
+      // A value of another JSON type than the reading expects, where no check says so itself
+      // (found by FuzzComplexJson): reported at the element being read, reading stops.
+      report("a value has the wrong JSON type (" + jsonMessage(e.what()) + ")", current_);
+    }
     throwIfFailed();
     return k;
   }
@@ -80,8 +102,16 @@ private:
   {
     // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..." ->
     // the part after the position, which we print ourselves.
+    // Other exceptions: "[json.exception.type_error.306] cannot use value() with number" -> the
+    // part after the tag.
     const auto colon = what.find(": ");
-    return colon == std::string::npos ? what : what.substr(colon + 2);
+    if (colon != std::string::npos)
+    {
+      return what.substr(colon + 2);
+    }
+    const auto tag = what.find("] ");
+    return what.rfind("[json.exception.", 0) == 0 && tag != std::string::npos ? what.substr(tag + 2)
+                                                                              : what;
   }
 
   void report(const std::string& message, std::size_t offset = std::string::npos)
@@ -312,8 +342,12 @@ private:
   {
     if (doc.contains("attributes"))
     {
-      for (const auto& [name, spec] : doc["attributes"].items())
+      for (const auto& item : doc["attributes"].items())
       {
+        // Not a structured binding: the lambda below uses `spec`, which C++17 does not let a
+        // lambda capture from a binding (clang refuses it).
+        const std::string& name = item.key();
+        const Json& spec = item.value();
         current_ = locateKey(name);
         complex::AttributeDefaults d;
         d.components = spec.value("components", 1);
@@ -369,8 +403,16 @@ private:
     }
     for (const auto& [attribute, spec] : cell["attributes"].items())
     {
+      if (!spec.is_string() &&
+        !(spec.is_object() && spec.contains("function") && spec["function"].is_string()))
+      {
+        report("cell '" + c.name + "': attribute '" + attribute +
+            "' must name an attribute function: \"f\" or {\"function\": \"f\", \"priority\": p}",
+          current_);
+        continue;
+      }
       const std::string function =
-        spec.is_string() ? spec.get<std::string>() : spec.value("function", std::string());
+        spec.is_string() ? spec.get<std::string>() : spec["function"].get<std::string>();
       auto it = functions_.find(function);
       if (it == functions_.end())
       {

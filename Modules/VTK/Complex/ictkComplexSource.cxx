@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkComplexSource.h"
 #include "ictkComplexToVTK.h"
+#include "ictkErrorCapture.h"
 #include "ictkRequest.h"
 
 #include "Complex/Discretization.h"
@@ -14,6 +15,7 @@
 #include "vtkDataAssembly.h"
 #include "vtkFieldData.h"
 #include "vtkImageData.h"
+#include "vtkImageReader2.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseKey.h"
 #include "vtkInformationVector.h"
@@ -36,6 +38,7 @@
 #include "vtkUnstructuredGrid.h"
 #include "vtkXMLImageDataReader.h"
 #include "vtkXMLPolyDataReader.h"
+#include "vtkXMLReader.h"
 #include "vtkXMLUnstructuredGridReader.h"
 
 #include <algorithm>
@@ -43,6 +46,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <type_traits>
 
 vtkStandardNewMacro(ictkComplexSource);
 vtkInformationKeyMacro(ictkComplexSource, COMPLEX, ObjectBase);
@@ -113,6 +117,75 @@ namespace
 {
 using namespace ictk;
 
+/// The type="..." of a VTK XML file's root element ("PolyData"), or "" when there is none.
+std::string xmlFileType(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const std::size_t root = head.find("<VTKFile");
+  const std::size_t type = root == std::string::npos ? root : head.find("type=\"", root);
+  const std::size_t end = type == std::string::npos ? type : head.find('"', type + 6);
+  return end == std::string::npos ? std::string() : head.substr(type + 6, end - type - 6);
+}
+
+/// What a reader's errors mean, in the user's words where VTK's are obscure: the XML parser's
+/// "Error parsing XML in stream at line 1, column 0, byte index 0: syntax error" is a file that
+/// is not XML at all, a missing element a VTK file of another kind, an unreadable extent data
+/// cut short. The executive's "returned failure for request" (with its vtkInformation listing)
+/// only repeats that the reader failed.
+std::string readFailure(
+  const std::string& path, const std::vector<std::string>& errors, const std::string& expected)
+{
+  const std::string e = ictk::vtk::firstCause(errors);
+  if (e.empty())
+  {
+    return "VTK's reader failed without saying why";
+  }
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) == 0 && !ec)
+  {
+    return "the file is empty";
+  }
+  const std::string xml = "Error parsing XML in stream at ";
+  if (e.rfind(xml, 0) == 0)
+  {
+    const std::size_t colon = e.find(": ", xml.size());
+    const std::string where = e.substr(xml.size(), colon - xml.size());
+    const std::string why = colon == std::string::npos ? std::string() : e.substr(colon + 2);
+    if (where.find("byte index 0") != std::string::npos)
+    {
+      return "not an XML file";
+    }
+    // "line L, column C, byte index B": expat counts columns from 0, ICTK's diagnostics from 1.
+    int line = 0;
+    int column = 0;
+    if (std::sscanf(where.c_str(), "line %d, column %d", &line, &column) == 2)
+    {
+      return "not well-formed XML (line " + std::to_string(line) + ", column " +
+        std::to_string(column + 1) + ": " + why + ")";
+    }
+    return "not well-formed XML (" + where + ": " + why + ")";
+  }
+  if (e.rfind("Cannot find ", 0) == 0 && e.find(" element in file") != std::string::npos)
+  {
+    const std::string type = xmlFileType(path);
+    return type.empty() ? "not a VTK XML " + expected + " file"
+                        : "a VTK " + type + " file, not " + expected;
+  }
+  const std::string stl = "STLReader error reading file: " + path + " ";
+  if (e.rfind(stl, 0) == 0)
+  {
+    return e.substr(stl.size());
+  }
+  if (e.rfind("Error reading extent", 0) == 0)
+  {
+    return "its data is cut short or corrupt (" + e + ")";
+  }
+  return e;
+}
+
 bool endsWith(std::string s, const std::string& suffix)
 {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -120,9 +193,12 @@ bool endsWith(std::string s, const std::string& suffix)
     s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-/// Runs a VTK reader and fails with the file's name when it reports an error or reads nothing.
+/// Runs a VTK reader and fails with the file's name and what was wrong when it reports an error
+/// or reads nothing; VTK's own reports are captured (ictkErrorCapture.h), not printed. `format`
+/// names what the file should be ("ImageData", "MetaImage"). Readers that can tell their format
+/// are asked first: MetaImage's library prints its complaints to stderr itself.
 template <typename Reader>
-vtkSmartPointer<Reader> readWith(const std::string& path)
+vtkSmartPointer<Reader> readWith(const std::string& path, const std::string& format)
 {
   if (FILE* f = std::fopen(path.c_str(), "rb"))
   {
@@ -133,11 +209,32 @@ vtkSmartPointer<Reader> readWith(const std::string& path)
     throw std::invalid_argument("cannot open '" + path + "'");
   }
   auto reader = vtkSmartPointer<Reader>::New();
+  bool known = true;
+  if constexpr (std::is_base_of_v<vtkImageReader2, Reader>)
+  {
+    known = reader->CanReadFile(path.c_str()) != 0;
+  }
+  else if constexpr (std::is_same_v<vtkPLYReader, Reader>)
+  {
+    known = vtkPLYReader::CanReadFile(path.c_str()) != 0;
+  }
+  if (!known)
+  {
+    throw std::invalid_argument("cannot read '" + path + "': not a " + format + " file");
+  }
+  ictk::vtk::ErrorCapture capture;
+  capture.WatchAlgorithm(reader);
+  if constexpr (std::is_base_of_v<vtkXMLReader, Reader>)
+  {
+    reader->SetParserErrorObserver(capture.Observer());
+    reader->SetReaderErrorObserver(capture.Observer());
+  }
   reader->SetFileName(path.c_str());
   reader->Update();
-  if (reader->GetErrorCode() != 0 || !reader->GetOutputDataObject(0))
+  if (!capture.Errors.empty() || reader->GetErrorCode() != 0 || !reader->GetOutputDataObject(0))
   {
-    throw std::invalid_argument("cannot read '" + path + "'");
+    throw std::invalid_argument("cannot read '" + path + "'" +
+      (capture.Errors.empty() ? std::string() : ": " + readFailure(path, capture.Errors, format)));
   }
   return reader;
 }
@@ -147,23 +244,23 @@ complex::ExplicitGeometry readMesh(const std::string& path)
   vtkSmartPointer<vtkDataSet> data;
   if (endsWith(path, ".vtu"))
   {
-    data = readWith<vtkXMLUnstructuredGridReader>(path)->GetOutput();
+    data = readWith<vtkXMLUnstructuredGridReader>(path, "UnstructuredGrid")->GetOutput();
   }
   else if (endsWith(path, ".vtp"))
   {
-    data = readWith<vtkXMLPolyDataReader>(path)->GetOutput();
+    data = readWith<vtkXMLPolyDataReader>(path, "PolyData")->GetOutput();
   }
   else if (endsWith(path, ".stl"))
   {
-    data = readWith<vtkSTLReader>(path)->GetOutput();
+    data = readWith<vtkSTLReader>(path, "STL")->GetOutput();
   }
   else if (endsWith(path, ".ply"))
   {
-    data = readWith<vtkPLYReader>(path)->GetOutput();
+    data = readWith<vtkPLYReader>(path, "PLY")->GetOutput();
   }
   else if (endsWith(path, ".obj"))
   {
-    data = readWith<vtkOBJReader>(path)->GetOutput();
+    data = readWith<vtkOBJReader>(path, "OBJ")->GetOutput();
   }
   else
   {
@@ -233,19 +330,19 @@ std::shared_ptr<voxel::VoxelGrid> readVolume(const std::string& path, const std:
   vtkSmartPointer<vtkImageData> image;
   if (endsWith(path, ".vti"))
   {
-    image = readWith<vtkXMLImageDataReader>(path)->GetOutput();
+    image = readWith<vtkXMLImageDataReader>(path, "ImageData")->GetOutput();
   }
   else if (endsWith(path, ".mha") || endsWith(path, ".mhd"))
   {
-    image = readWith<vtkMetaImageReader>(path)->GetOutput();
+    image = readWith<vtkMetaImageReader>(path, "MetaImage")->GetOutput();
   }
   else if (endsWith(path, ".nii") || endsWith(path, ".nii.gz"))
   {
-    image = readWith<vtkNIFTIImageReader>(path)->GetOutput();
+    image = readWith<vtkNIFTIImageReader>(path, "NIfTI")->GetOutput();
   }
   else if (endsWith(path, ".nrrd") || endsWith(path, ".nhdr"))
   {
-    image = readWith<vtkNrrdReader>(path)->GetOutput();
+    image = readWith<vtkNrrdReader>(path, "NRRD")->GetOutput();
   }
   else
   {
