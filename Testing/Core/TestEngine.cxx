@@ -273,6 +273,34 @@ TEST(EngineExemplars, AndyhausenRunsItsWholeFilm)
   EXPECT_NEAR(real(m, "Skeleton.height"), 2.430625, 1e-4);
 }
 
+TEST(EngineExemplars, AndyhausenMeltingEggFollowsItsBlendRate)
+{
+  // Melting_egg = blend(Liquid, Egg_contents, 0.5 * blendRate), blendRate = clamp(lifeT / 5, 0, 1)
+  // (thesis L3636-L3659): from the instance EGG_ERODING on, the blend grows from a plain union to
+  // an amount of 0.5 over the cell's first five seconds, step by step.
+  DynamicModel m = load("andyhausen.icm");
+  std::vector<double> amounts;
+  for (int k = 0; k <= 100; ++k)
+  {
+    m.advanceTo(0.2 * k, 0.2);
+    for (const ictk::engine::CellState& c : m.cells())
+    {
+      if (c.name != "Melting_egg")
+        continue;
+      ASSERT_EQ(c.shape->parts.size(), 1u);
+      const double rate = real(m, "Melting_egg.blendRate");
+      EXPECT_GE(rate, 0.0);
+      EXPECT_LE(rate, 1.0);
+      EXPECT_DOUBLE_EQ(c.shape->parts[0].amount, 0.5 * rate) << "t = " << m.time();
+      amounts.push_back(c.shape->parts[0].amount);
+    }
+  }
+  ASSERT_GE(amounts.size(), 30u);
+  EXPECT_LT(amounts.front(), 0.05);
+  EXPECT_DOUBLE_EQ(amounts.back(), 0.5);
+  EXPECT_TRUE(std::is_sorted(amounts.begin(), amounts.end()));
+}
+
 TEST(EngineExemplars, Deterministic)
 {
   auto run = []
