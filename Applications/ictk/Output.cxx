@@ -278,14 +278,10 @@ void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::st
   fs::remove_all(staging);
 }
 
-void WriteUnstructuredGrid(
-  vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination)
+void WriteUnstructuredGrid(vtkUnstructuredGrid* grid, AtomicOutput& file)
 {
   vtkNew<vtkXMLUnstructuredGridWriter> writer;
   writer->SetDataModeToAppended();
-  // In memory, then written and checked by AtomicOutput (a full disk fails cleanly); `destination`
-  // names the file in AtomicOutput's own messages.
-  (void)destination;
   WriteXml(writer, grid, file);
   file.Commit();
 }
@@ -295,7 +291,7 @@ void WriteTetMeshVtu(const mesh::TetMesh& m, const std::string& path)
   vtkNew<vtkUnstructuredGrid> grid;
   ictkTetrahedralize::Convert(m, grid);
   AtomicOutput file(path);
-  WriteUnstructuredGrid(grid, file, path);
+  WriteUnstructuredGrid(grid, file);
 }
 
 } // namespace ictk::cli

@@ -57,10 +57,9 @@ void WriteXml(vtkXMLWriter* writer, vtkDataObject* data, AtomicOutput& file);
 /// replaced only when it holds nothing but pieces of this file.
 void WriteComposite(vtkXMLWriterBase* writer, vtkDataObject* data, const std::string& output);
 
-/// Writes `grid` as a .vtu (appended data) into `file` and commits it; throws UserError naming
-/// `destination` when the writer fails.
-void WriteUnstructuredGrid(
-  vtkUnstructuredGrid* grid, AtomicOutput& file, const std::string& destination);
+/// Writes `grid` as a .vtu (appended data) into `file` (through WriteXml) and commits it; throws
+/// UserError naming the file's destination when writing fails.
+void WriteUnstructuredGrid(vtkUnstructuredGrid* grid, AtomicOutput& file);
 
 /// A tetrahedral mesh as a .vtu (ictkTetrahedralize's form: MaterialId, CellId and the
 /// per-tetrahedron arrays), through a temporary file renamed on success.

@@ -168,7 +168,7 @@ void WritePng(const PictureBuffers& picture, AtomicOutput& file, const std::stri
   file.Commit();
 }
 
-void WriteDepth(const PictureBuffers& picture, AtomicOutput& file, const std::string& path)
+void WriteDepth(const PictureBuffers& picture, AtomicOutput& file)
 {
   vtkSmartPointer<vtkImageData> image = PixelImage(picture.Width, picture.Height);
   vtkNew<vtkDoubleArray> depth;
@@ -179,8 +179,6 @@ void WriteDepth(const PictureBuffers& picture, AtomicOutput& file, const std::st
   vtkNew<vtkXMLImageDataWriter> xml;
   xml->SetDataModeToAppended();
   xml->EncodeAppendedDataOff();
-  // In memory, then written and checked by AtomicOutput (a full disk fails cleanly).
-  (void)path;
   WriteXml(xml.Get(), image, file);
   file.Commit();
 }

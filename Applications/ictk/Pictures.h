@@ -27,8 +27,9 @@ struct PictureBuffers
 
 /// Writes the colour as PNG into `file` (an AtomicOutput of `path`) and commits it.
 void WritePng(const PictureBuffers& picture, AtomicOutput& file, const std::string& path);
-/// Writes the depth buffer (array `depth`, inf where nothing is hit) as .vti and commits it.
-void WriteDepth(const PictureBuffers& picture, AtomicOutput& file, const std::string& path);
+/// Writes the depth buffer (array `depth`, inf where nothing is hit) as .vti into `file` (through
+/// WriteXml: a full disk fails cleanly) and commits it.
+void WriteDepth(const PictureBuffers& picture, AtomicOutput& file);
 
 /// The destination of a range of frames: a pattern with one printf integer conversion (%d,
 /// %04d; %% for a percent sign) ending in .png, or an .mp4 file (needs ffmpeg on the PATH: the

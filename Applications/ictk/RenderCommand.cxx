@@ -577,7 +577,7 @@ private:
     WritePng(drawn.Buffers(), picture, this->Output);
     if (depthFile)
     {
-      WriteDepth(drawn.Buffers(), *depthFile, this->Depth);
+      WriteDepth(drawn.Buffers(), *depthFile);
     }
     std::cout << "wrote " << this->Output << (depthFile ? " and " + this->Depth : std::string())
               << " (" << drawn.Width << " x " << drawn.Height << ", " << Describe(drawn) << ") in "

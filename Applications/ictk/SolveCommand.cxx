@@ -143,7 +143,7 @@ int SolveCommand::run()
   const mesh::PointResults results = mesh::resultsOnMesh(m, mesh::readFrd(r.run.frd));
   vtkNew<vtkUnstructuredGrid> grid;
   ictk::vtk::solverResultsToVTK(m, results, r.compression.materials, grid);
-  WriteUnstructuredGrid(grid, file, o.Output);
+  WriteUnstructuredGrid(grid, file);
   const double seconds = Seconds(t0);
   const auto& c = r.compression;
   double largest = 0;
