@@ -52,6 +52,17 @@ lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>
 
 ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<double>& params)
 {
+  // A complex or a dynamic model is not one FRep model: say which commands take it rather than
+  // "unknown model".
+  if (IsComplexInput(nameOrPath) || HasExtension(nameOrPath, ".icm"))
+  {
+    throw UserError("'" + nameOrPath + "' is " +
+      (IsComplexInput(nameOrPath) ? "a complex (.json): `ictk mesh`, `tetra`, `info`, `validate` "
+                                    "and `render` take complexes"
+                                  : "a dynamic model (.icm): `ictk run` and `render` take .icm "
+                                    "models") +
+      "; this command takes one FRep model (a registered name, a .hf or a .xml file)");
+  }
   if (!lang::isModelFile(nameOrPath))
   {
     const frep::ModelInfo& info = FindModel(nameOrPath);
