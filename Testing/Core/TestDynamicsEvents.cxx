@@ -166,6 +166,46 @@ TEST(DynamicsEvents, TimeRejectedWithARequestedStep)
   EXPECT_EQ(s.params().value("Guard.count"), 5.0);
 }
 
+TEST(DynamicsEvents, RefinedStepsGrowAgainWhenAsked)
+{
+  // A reaction that needs steps of at most 0.1 across t = 0.3 (and halves otherwise). Keeping the
+  // refined size: 0.25, then 0.3125 after two halvings, then steps of 0.0625 up to 1 (13 frames).
+  // Growing: 0.25, 0.3125, then 0.125, 0.25 and the rest: 0.4375, 0.6875, 1 (5 frames).
+  for (const bool grow : { false, true })
+  {
+    ParameterTable p;
+    p.add("Guard", "count", Scope::Global, 0.0);
+    Stepper s(p);
+    StepperOptions o;
+    o.growRefinedSteps = grow;
+    s.setOptions(o);
+    Reaction r;
+    r.name = "Guard";
+    r.update = [](StepContext& c)
+    {
+      c.set("Guard.count", c.get("Guard.count") + 1);
+      if (c.dt > 0.1 && c.globalT - c.dt < 0.3 && c.globalT >= 0.3)
+        c.rejectTime();
+    };
+    s.addReaction(r);
+    if (grow)
+    {
+      EXPECT_EQ(s.step(1.0), 5);
+      EXPECT_THAT(s.acceptedTimes(), ElementsAre(0.25, 0.3125, 0.4375, 0.6875, 1.0));
+      EXPECT_EQ(s.rejections(), 5); // 1, 0.5, then 0.5, 0.25, 0.125 from 0.25
+    }
+    else
+    {
+      EXPECT_EQ(s.step(1.0), 13);
+      EXPECT_EQ(s.acceptedTimes()[1], 0.3125);
+      EXPECT_EQ(s.acceptedTimes()[2], 0.375);
+      EXPECT_EQ(s.rejections(), 4); // 1, 0.5, then 0.25, 0.125 from 0.25
+    }
+    EXPECT_EQ(s.acceptedTimes().back(), 1.0);
+    EXPECT_EQ(s.params().value("Guard.count"), static_cast<double>(s.acceptedTimes().size()));
+  }
+}
+
 TEST(DynamicsEvents, TimeRejectedLimits)
 {
   // A step back before the last correctly evaluated time makes the model invalid (L2082).

@@ -21,6 +21,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -358,11 +359,263 @@ TEST(SpaceTimeBlend, XYTModelIsASolidOfSpaceTime)
     EXPECT_EQ(space.eval(x, y, t, 123.0), model.eval(x, y, 0, t));
     // Before t0 the cross, after t1 the disks.
     if (std::abs(cross(x, y)) > 1e-9)
+    {
       EXPECT_EQ(space.eval(x, y, -0.25, 0) >= 0, cross(x, y) > 0);
+    }
     if (std::abs(disks(x, y)) > 1e-9)
+    {
       EXPECT_EQ(space.eval(x, y, 1.25, 0) >= 0, disks(x, y) > 0);
+    }
   }
   EXPECT_THROW(ictk::frep::spaceTimeSolid(ictk::frep::Hypervolume(
                  ictk::frep::Shape(ictk::frep::Expr::x(), ictk::frep::Domain::XYZ))),
     ictk::frep::DomainError);
+}
+
+namespace
+{
+
+/// Thesis 5.3.4's STB_CELL (Data/Models/icm/ch5_3_4_nonlinear_sampling.icm) in the plane: the disk
+/// of radius 1 becomes the disk of radius 0.5 at (1.5, 0) between t = 1 and 2, and a step whose
+/// cross-section's area changed by more than volumeRate is rejected and retried at dt / 2.
+std::string nonlinearSamplingModel(const std::string& update)
+{
+  return R"(name = NONLINEAR;
+steps = grow;
+TIMESPANS { film : TIMESPAN(0, 3); }
+CELLS {
+  BIG { type = F-CELL; shape = disk(1); dim = 2D; domain = { -1, -1, 1, 1 }; }
+  SMALL {
+    type = F-CELL; shape = disk(0.5); dim = 2D; domain = { -0.5, -0.5, 0.5, 0.5 };
+    parameters { translation(1.5, 0, 0); }
+  }
+  STB_CELL {
+    type = T-CELL;
+    shape = spaceTimeBlendCells(BIG, SMALL, 1, 2, 1, 1, 1, 0.2);
+    dim = 3D;
+    domain = { -1.5, -1.5, 2.5, 1.5 };
+    parameters {
+      shapeVolume : REAL(0.0);
+      volumeRate : REAL(0.2);
+      timeDivider : REAL(2.0);
+      acceptedSteps : INT(0);
+      largestChange : REAL(0.0);
+    }
+    REACTIONS {
+      update(REAL globalT, REAL localT, REAL lifeT, REAL dt)
+      {
+)" + update +
+    R"(
+      }
+    }
+  }
+}
+K { CELLS { STB_CELL; } }
+)";
+}
+
+const char* const kVolumeRateUpdate = R"(
+        SHAPE crossSection = makeCrossSection(shape, globalT);
+        REAL curVolume = getVolume(crossSection);
+        if (shapeVolume > 0 && abs(curVolume - shapeVolume) > volumeRate * shapeVolume) {
+          IC::fireEvent(TIME_REJECTED, dt / timeDivider);
+        } else {
+          if (shapeVolume > 0) {
+            largestChange = max(largestChange, abs(curVolume - shapeVolume) / shapeVolume);
+          }
+          shapeVolume = curVolume;
+          acceptedSteps = acceptedSteps + 1;
+        })";
+
+} // namespace
+
+TEST(SpaceTimeBlend, VolumeRateRefinesTheStepsWhereTheTransitionIsFast)
+{
+  engine::DynamicModel m(
+    ictk::lang::readIcm(nonlinearSamplingModel(kVolumeRateUpdate), "nonlinear.icm"));
+  m.start();
+  // Area pi before t0, pi / 4 after t1 (the blend's area is integrated: 1e-4).
+  EXPECT_NEAR(m.value("STB_CELL.shapeVolume").number, Pi, 1e-4 * Pi);
+  std::vector<engine::FrameRecord> frames;
+  for (int k = 1; k <= 12; ++k)
+    for (engine::FrameRecord& r : m.advanceTo(0.25 * k, 0.25))
+      frames.push_back(std::move(r));
+  // Every requested frame is delivered, each with the steps that reached it.
+  ASSERT_EQ(frames.size(), 12u);
+  std::size_t steps = 0, rejected = 0;
+  double last = 0.0;
+  for (std::size_t k = 0; k < frames.size(); ++k)
+  {
+    const engine::FrameRecord& r = frames[k];
+    EXPECT_DOUBLE_EQ(r.time, 0.25 * static_cast<double>(k + 1));
+    ASSERT_FALSE(r.steps.empty());
+    EXPECT_DOUBLE_EQ(r.steps.back(), r.time);
+    for (double t : r.steps)
+    {
+      EXPECT_GT(t, last); // never back before the last accepted time (thesis L2082)
+      last = t;
+    }
+    steps += r.steps.size();
+    rejected += static_cast<std::size_t>(r.rejectedSteps);
+    // Outside the transition the area does not change: one step per frame.
+    if (r.time <= 1.0 || r.time > 2.25)
+    {
+      EXPECT_EQ(r.steps.size(), 1u) << "t = " << r.time;
+      EXPECT_EQ(r.rejectedSteps, 0) << "t = " << r.time;
+    }
+  }
+  EXPECT_EQ(m.value("STB_CELL.acceptedSteps").number, static_cast<double>(steps + 1)); // + start
+  // pi -> pi / 4 at most 20 % a step needs at least ln 4 / ln 1.25 = 6.2 steps, here within the
+  // four frames of the transition.
+  std::size_t during = 0;
+  for (const engine::FrameRecord& r : frames)
+    if (r.time > 1.0 && r.time <= 2.25)
+      during += r.steps.size();
+  EXPECT_GE(during, 7u);
+  EXPECT_GT(rejected, 0u);
+  EXPECT_LE(m.value("STB_CELL.largestChange").number, 0.2);
+  EXPECT_GT(m.value("STB_CELL.largestChange").number, 0.05);
+  EXPECT_NEAR(m.value("STB_CELL.shapeVolume").number, Pi / 4, 1e-4 * Pi);
+}
+
+TEST(SpaceTimeBlend, CrossSectionsAreTakenAtTheTimeBeingEvaluated)
+{
+  // makeCrossSection cuts where the engine evaluates; anywhere else is refused, never computed
+  // silently at another time; a cell without time has no cross-section.
+  for (const auto& [update, message] : std::vector<std::pair<std::string, std::string>>{
+         { "REAL v = getVolume(makeCrossSection(shape, globalT + 0.5));",
+           "the model is evaluating t = " },
+         { "REAL v = getVolume(makeCrossSection(BIG.shape, globalT));",
+           "BIG is not a space-time cell" },
+         { "REAL v = getVolume(segment(vec3(0, 0, 0), vec3(1, 0, 0)));",
+           "getVolume takes a cell's shape" } })
+  {
+    engine::DynamicModel m(ictk::lang::readIcm(nonlinearSamplingModel(update), "nonlinear.icm"));
+    try
+    {
+      m.start();
+      m.advanceTo(0.5, 0.25);
+      ADD_FAILURE() << update;
+    }
+    catch (const engine::ModelError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("nonlinear.icm:"), std::string::npos) << e.what();
+    }
+  }
+}
+
+namespace
+{
+
+/// Two disks of radius 0.3 at x = -1 and x = 1 blended between t = 1 and t = 2: far apart for
+/// their size, the case thesis 5.3.2 says breaks into separate components (L3096).
+engine::DynamicModel farDisks(const std::string& align)
+{
+  return engine::DynamicModel(ictk::lang::readIcm(R"(name = FAR;
+TIMESPANS { film : TIMESPAN(0, 3); }
+CELLS {
+  LEFT {
+    type = F-CELL; shape = disk(0.3); dim = 2D; domain = { -0.3, -0.3, 0.3, 0.3 };
+    parameters { translation(-1, 0, 0); }
+  }
+  RIGHT {
+    type = F-CELL; shape = disk(0.3); dim = 2D; domain = { -0.3, -0.3, 0.3, 0.3 };
+    parameters { translation(1, 0, 0); }
+  }
+  MORPH {
+    type = T-CELL;
+    shape = spaceTimeBlendCells(LEFT, RIGHT, 1, 2, 0.5, 1, 1, 0.2)" +
+      align + R"();
+    dim = 3D;
+    domain = { -1.5, -1.5, 1.5, 1.5 };
+  }
+}
+K { CELLS { MORPH; } }
+)",
+    "far.icm"));
+}
+
+} // namespace
+
+TEST(SpaceTimeBlend, AutomaticAlignmentKeepsTheTransitionInOnePiece)
+{
+  std::vector<int> plain, aligned;
+  for (const std::string align : { "", ", 1" })
+  {
+    engine::DynamicModel m = farDisks(align);
+    m.start();
+    for (int k = 0; k <= 10; ++k)
+    {
+      const double t = 0.95 + 0.1 * k; // 0.95 .. 1.95, then 2.5
+      m.advanceTo(k == 10 ? 2.5 : t, 0.5);
+      const auto slice = valueOf(*m.cells()[0].shape);
+      (align.empty() ? plain : aligned).push_back(components(slice));
+      // Aligned, both extrusions sit on the same box, the one a fraction u of the way from LEFT
+      // to RIGHT: the slice is centred at x = -1 + 2u.
+      if (!align.empty() && k < 10 && t > 1)
+      {
+        double sum = 0;
+        int inside = 0;
+        for (int j = 0; j < N; ++j)
+          for (int i = 0; i < N; ++i)
+            if (slice(gridCoordinate(i), gridCoordinate(j)) >= 0)
+            {
+              sum += gridCoordinate(i);
+              ++inside;
+            }
+        ASSERT_GT(inside, 0);
+        EXPECT_NEAR(sum / inside, -1 + 2 * (t - 1), 0.02) << "t = " << t;
+      }
+      // Before t0 LEFT, after t1 RIGHT, aligned or not (sign on the grid).
+      if (k == 0 || k == 10)
+      {
+        const double cx = k == 0 ? -1 : 1;
+        int differ = 0;
+        for (int j = 0; j < N; ++j)
+          for (int i = 0; i < N; ++i)
+          {
+            const double x = gridCoordinate(i), y = gridCoordinate(j);
+            const double e = 0.3 - std::hypot(x - cx, y);
+            differ += std::abs(e) > 1e-2 && (slice(x, y) >= 0) != (e > 0);
+          }
+        EXPECT_EQ(differ, 0) << "align '" << align << "' at t = " << t;
+      }
+    }
+  }
+  // Plain blending loses the shape halfway (no component at t = 1.35 .. 1.65); aligned, one
+  // component at every slice.
+  EXPECT_GE(std::count(plain.begin(), plain.end(), 0), 3);
+  EXPECT_EQ(std::count(aligned.begin(), aligned.end(), 1), 11);
+  // A fraction outside [0, 1] is refused at its place.
+  try
+  {
+    farDisks(", 1.5");
+    ADD_FAILURE() << "align 1.5 accepted";
+  }
+  catch (const engine::ModelError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("far.icm:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("alignment of MORPH"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SpaceTimeBlend, ThesisStbCellSamplesItsFourDimensionalFilm)
+{
+  // Data/Models/icm/ch5_3_4_nonlinear_sampling.icm: the ball of radius 1 becomes the ball of
+  // radius 0.5 at x = 1.5 between t = 1 and 2, the volume 4/3 pi -> 4/3 pi / 8 in accepted steps
+  // that each change it by at most 20 %, refined only during the transition.
+  engine::DynamicModel m = engine::DynamicModel::load(
+    std::string(ICTK_DATA_DIR) + "/Models/icm/ch5_3_4_nonlinear_sampling.icm");
+  m.start();
+  EXPECT_NEAR(m.value("STB_CELL.shapeVolume").number, 4 * Pi / 3, 1e-3 * 4 * Pi / 3);
+  std::size_t outside = 0, during = 0;
+  for (int k = 1; k <= 6; ++k)
+    for (const engine::FrameRecord& r : m.advanceTo(0.5 * k, 0.5))
+      (r.time > 1 && r.time <= 2.5 ? during : outside) += r.steps.size();
+  EXPECT_EQ(outside, 3u); // t = 0.5, 1 and 3
+  // A step keeps at least 80 % of the volume: ln 8 / ln 1.25 = 9.3, at least 10 steps.
+  EXPECT_GE(during, 10u);
+  EXPECT_LE(m.value("STB_CELL.largestChange").number, 0.2);
+  EXPECT_NEAR(m.value("STB_CELL.shapeVolume").number, Pi / 6, 1e-3 * Pi / 6);
 }

@@ -313,6 +313,8 @@ int Stepper::step(double dt)
         t_ = tNew;
         accepted_.push_back(tNew);
         ++frames;
+        if (options_.growRefinedSteps)
+          h = std::min(2 * h, dt);
         break;
       }
       restore(s);

@@ -27,9 +27,9 @@
 // maxHalvings rejections of one attempt, StepRejectedError. A requested step <= 0 would go back
 // before the last correctly evaluated time, which makes the model invalid (L2082): SteppingError.
 // An exception thrown by a callback also restores the state before it propagates.
-// After an accepted sub-step the stepper continues with steps of the accepted size until the
-// requested time is reached, so the caller always gets the state at the time it asked for
-// (fig. 56b, L2070).
+// After an accepted sub-step the stepper continues with steps of the accepted size (or, with
+// StepperOptions::growRefinedSteps, twice that size) until the requested time is reached, so the
+// caller always gets the state at the time it asked for (fig. 56b, L2070).
 //
 // Callbacks must keep their state in the ParameterTable (or in events): the stepper re-runs frames
 // after restoring it, and stepUntil() re-runs a step several times to locate a transition.
@@ -115,6 +115,11 @@ struct StepperOptions
   /// evaluated). The dependent then keeps what its own reactions wrote while its master is
   /// unchanged, which a bidirectional pair (Andyhausen's handles) needs. Off: every frame copies.
   bool pullChangedOnly = false;
+  /// After a sub-step refined by TIME_REJECTED is accepted, the next one is twice as long (up to
+  /// what is left of the requested step) instead of keeping the refined size: the steps follow
+  /// how fast the model changes (thesis 5.3.4's non-linear sampling) rather than staying at the
+  /// smallest size until the requested time.
+  bool growRefinedSteps = false;
 };
 
 class Stepper

@@ -51,6 +51,10 @@ struct FrameRecord
   std::string instance;            ///< the active instance after this time was evaluated
   bool transition = false;         ///< a located change of instance (not a requested time)
   std::vector<std::string> events; ///< events dispatched while reaching this time, in order
+  /// The times the engine accepted while reaching this one, in order (the last is `time`): more
+  /// than one where a reaction rejected the time (TIME_REJECTED) and the step was refined.
+  std::vector<double> steps;
+  int rejectedSteps = 0; ///< the steps rejected on the way (TIME_REJECTED)
   /// The model's state parameters and the active instance's ones, in definition order.
   std::vector<std::pair<std::string, Value>> state;
 };

@@ -300,7 +300,7 @@ Value Interpreter::eval(const Expr& e, Frame& f) const
       {
         const Expr& a = *e.kids[i];
         // An event name is not a value: fireEvent's first argument is passed by name.
-        if (i == 1 && e.text == "fireEvent" && a.kind == Expr::Kind::Name &&
+        if (i == 1 && lang::icm::calledName(e.text) == "fireEvent" && a.kind == Expr::Kind::Name &&
           !f.locals.count(a.text))
           args.push_back(Value::string(a.text));
         else
@@ -603,7 +603,7 @@ std::vector<lang::icm::BuiltinId> interpreterBuiltins()
 
 Value Interpreter::callFunction(const Expr& call, std::vector<Value> args, Frame& f) const
 {
-  const std::string& name = call.text;
+  const std::string name = lang::icm::calledName(call.text);
   const lang::icm::Builtin* builtin = lang::icm::findBuiltin(name);
   if (builtin && builtin->layer == lang::icm::BuiltinLayer::Math)
   {
@@ -680,6 +680,8 @@ bool Interpreter::exec(const Stmt& s, Frame& f) const
         want = Value::Type::Vec3;
       else if (t == "string" || t == "STRING")
         want = Value::Type::String;
+      else if (t == "shape" || t == "SHAPE")
+        want = Value::Type::Shape;
       if (want == Value::Type::Real && v.isNumber())
         v = Value::real(v.number);
       else if (want == Value::Type::Int && v.isNumber())

@@ -115,6 +115,7 @@ void ModelState::build()
       const OperandNumbers n = evaluateOperands(c, kNone);
       c.operands->amount = n.amount;
       c.operands->spaceTime = n.spaceTime;
+      c.operands->align = n.align;
     }
 }
 
@@ -136,6 +137,14 @@ OperandNumbers ModelState::evaluateOperands(const CellSpec& c, std::size_t insta
           " must be a finite number");
     if (spaceTimeBlend && i < 6)
       *slots[i] = v.number;
+    else if (spaceTimeBlend && i == 6)
+    {
+      if (!(v.number >= 0 && v.number <= 1))
+        fail(e.pos,
+          "the alignment of " + c.name + " is a fraction from 0 (none) to 1 (the operands meet " +
+            "halfway), it is " + std::to_string(v.number));
+      out.align = v.number;
+    }
     else if (!spaceTimeBlend && i == 0)
     {
       if (v.number < 0)
@@ -811,6 +820,7 @@ void ModelState::buildStepper()
   dyn::StepperOptions so;
   so.cycles = options.cycles;
   so.pullChangedOnly = true;
+  so.growRefinedSteps = model.steps.text == "grow";
   stepper->setOptions(so);
   for (const CellSpec& c : cells)
   {

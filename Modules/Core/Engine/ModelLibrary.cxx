@@ -124,6 +124,43 @@ Value setShapeParameter(const LibraryCall& call)
   return {};
 }
 
+/// The cell whose `shape` a shape value is (Cell.shape, makeCrossSection(...)); the shapes code
+/// builds (segment(...), arc(...)) belong to no cell yet.
+const CellSpec& shapeOwner(const LibraryCall& call, const char* what)
+{
+  const Value& v = call.args.at(0);
+  if (v.type != Value::Type::Shape || v.text.empty())
+    throw std::runtime_error(
+      std::string(what) + " takes a cell's shape (`shape` in its reactions)");
+  return call.m.cells[call.m.cellIndex.at(v.text)];
+}
+
+/// makeCrossSection(shape, t) (thesis L3160): the engine already sees a space-time cell as its
+/// cross-section at the time being evaluated, so this names that slice and refuses any other
+/// time rather than silently slicing somewhere else.
+Value makeCrossSection(const LibraryCall& call)
+{
+  const CellSpec& c = shapeOwner(call, "makeCrossSection");
+  if (!c.spaceTime)
+    throw std::runtime_error("makeCrossSection: " + c.name +
+      " is not a space-time cell (its shape has no time to cut at)");
+  const double t = call.args.at(1).number, now = call.m.shapeTime();
+  if (!(std::abs(t - now) <= 1e-12 * std::max(1.0, std::abs(now))))
+    throw std::runtime_error("makeCrossSection: the shape of " + c.name +
+      " is cut at t = " + std::to_string(t) +
+      ", but the model is evaluating t = " + std::to_string(now) + " (pass globalT)");
+  Value v = call.args[0];
+  v.fields["crossSectionTime"] = t;
+  return v;
+}
+
+/// getVolume(shape) (thesis L3162): the measure of the cell's shape as placed now.
+Value getVolume(const LibraryCall& call)
+{
+  const CellSpec& c = shapeOwner(call, "getVolume");
+  return Value::real(geometry::measure(*call.m.shapeOf(c.name), call.m.options.geometry));
+}
+
 /// jointPosition(cell, "joint"): the joint's origin posed at the cell's time, placed by the cell.
 Value jointPosition(const LibraryCall& call)
 {
@@ -219,6 +256,8 @@ const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
   { BuiltinId::Arc, shapePartOf },
   { BuiltinId::CircularSegment, shapePartOf },
   { BuiltinId::SetShapeParameter, setShapeParameter },
+  { BuiltinId::MakeCrossSection, makeCrossSection },
+  { BuiltinId::GetVolume, getVolume },
   { BuiltinId::JointPosition, jointPosition },
 };
 

@@ -176,6 +176,15 @@ FrameRecord ModelState::record(double t, bool transition)
   for (std::size_t i = processedSeen; i < processed.size(); ++i)
     r.events.push_back(processed[i].name);
   processedSeen = processed.size();
+  const auto& accepted = stepper->acceptedTimes();
+  // A transition is located by re-running steps from a saved state: what it saw of them is not
+  // history, so only the accepted times up to this record's time count.
+  for (std::size_t i = std::min(acceptedSeen, accepted.size()); i < accepted.size(); ++i)
+    if (accepted[i] <= t)
+      r.steps.push_back(accepted[i]);
+  acceptedSeen = accepted.size();
+  r.rejectedSteps = std::max(0, stepper->rejections() - rejectionsSeen);
+  rejectionsSeen = stepper->rejections();
   for (const std::string& n : modelStateNames)
     r.state.emplace_back(n, get(n));
   if (s.active != kNone)

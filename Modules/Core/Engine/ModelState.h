@@ -93,6 +93,7 @@ struct CellSpec
     /// Their values at the model's start (ModelState::evaluateOperands).
     double amount = 0.0;
     frep::SpaceTimeBlendParameters spaceTime; ///< SpaceTimeBlend only
+    double align = 0.0;                       ///< SpaceTimeBlend only (OperandNumbers::align)
     Pos pos;                                  ///< the constructor's call
   };
   std::optional<Operands> operands;
@@ -149,6 +150,9 @@ struct OperandNumbers
 {
   double amount = 0.0;
   frep::SpaceTimeBlendParameters spaceTime;
+  /// spaceTimeBlendCells' ninth number: how far the automatic space-time alignment moves each
+  /// operand toward the other's bounding domain (thesis 5.3.2 L3108; 0 = plain blending).
+  double align = 0.0;
 };
 
 /// The structural state: what the parameter table cannot hold. Copied with every snapshot.
@@ -194,6 +198,8 @@ struct ModelState
   std::size_t graphInstance = kNone;
   bool started = false;
   std::size_t processedSeen = 0;
+  std::size_t acceptedSeen = 0; ///< stepper->acceptedTimes() already reported in a FrameRecord
+  int rejectionsSeen = 0;
   std::uint64_t nextVersion = 1;
   dyn::StepContext* context = nullptr; ///< the frame being evaluated (events, TIME_REJECTED)
 
@@ -224,7 +230,7 @@ struct ModelState
     const auto it = s.operandNumbers.find(c.name);
     return it != s.operandNumbers.end()
       ? it->second
-      : OperandNumbers{ c.operands->amount, c.operands->spaceTime };
+      : OperandNumbers{ c.operands->amount, c.operands->spaceTime, c.operands->align };
   }
   void buildAnimations();
   void buildEvents();
@@ -277,6 +283,9 @@ struct ModelState
   Affine localPlace(const std::string& cell) const;
   Affine place(const std::string& cell, int depth = 0) const;
   PlacedShapePtr shapeOf(const std::string& cell, int depth = 0) const;
+  /// spaceTimeBlendCells' automatic alignment (OperandNumbers::align) of the operands at time t.
+  void alignInSpaceTime(
+    PlacedShapePtr& a, PlacedShapePtr& b, const OperandNumbers& n, double t) const;
   std::uint64_t versionOf(const std::string& cell, int depth = 0) const;
   void bumpVersion(const std::string& cell) { s.versions[cell] = nextVersion++; }
 

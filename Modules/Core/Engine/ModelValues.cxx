@@ -174,6 +174,59 @@ Affine ModelState::place(const std::string& cell, int depth) const
   return local;
 }
 
+namespace
+{
+
+/// The affine map taking box `from` onto box `to` (centre onto centre, each extent scaled; an axis
+/// on which either box is flat keeps its scale, a 2D shape's z).
+Affine boxOntoBox(const frep::Box3& from, const frep::Box3& to)
+{
+  Affine m;
+  for (int k = 0; k < 3; ++k)
+  {
+    const double e = from.hi[k] - from.lo[k], f = to.hi[k] - to.lo[k];
+    const double s = (e > 1e-12 && f > 1e-12) ? f / e : 1.0;
+    m.a[static_cast<std::size_t>(4 * k)] = s;
+    m.b[k] = 0.5 * (to.lo[k] + to.hi[k]) - s * 0.5 * (from.lo[k] + from.hi[k]);
+  }
+  return m;
+}
+
+frep::Box3 lerpBox(const frep::Box3& a, const frep::Box3& b, double u)
+{
+  frep::Box3 r;
+  for (int k = 0; k < 3; ++k)
+  {
+    r.lo[k] = a.lo[k] + u * (b.lo[k] - a.lo[k]);
+    r.hi[k] = a.hi[k] + u * (b.hi[k] - a.hi[k]);
+  }
+  return r;
+}
+
+} // namespace
+
+void ModelState::alignInSpaceTime(
+  PlacedShapePtr& a, PlacedShapePtr& b, const OperandNumbers& n, double t) const
+{
+  // Thesis 5.3.2 (L3098-L3108): time-dependent affine maps of the operands in space-time, made
+  // from their bounding domains. With u the transition's progress, A's extrusion is carried from
+  // its own box toward B's (a fraction align * u of the way) and B's from A's toward its own, so
+  // halfway through (align = 1) both sit on the middle box and overlap instead of thinning into
+  // separate components. Only the slice at t is ever evaluated, so mapping the operands as they
+  // are at t is the map of the space-time operands (before t0 A is unmoved, after t1 B is).
+  const frep::Box3 boxA = a->worldBounds(), boxB = b->worldBounds();
+  const double u = std::clamp((t - n.spaceTime.t0) / (n.spaceTime.t1 - n.spaceTime.t0), 0.0, 1.0);
+  auto moved = [](const PlacedShapePtr& s, const Affine& m)
+  {
+    auto c = std::make_shared<PlacedShape>(*s);
+    c->place = m * s->place;
+    return PlacedShapePtr(std::move(c));
+  };
+  const PlacedShapePtr movedA = moved(a, boxOntoBox(boxA, lerpBox(boxA, boxB, n.align * u)));
+  b = moved(b, boxOntoBox(boxB, lerpBox(boxB, boxA, n.align * (1 - u))));
+  a = movedA;
+}
+
 PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
 {
   if (depth > static_cast<int>(cells.size()))
@@ -189,7 +242,11 @@ PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
     PlacedShapePtr a = shapeOf(c.operands->a, depth + 1), b = shapeOf(c.operands->b, depth + 1);
     const OperandNumbers n = operandNumbersOf(c);
     if (c.operands->kind == ShapePart::Kind::SpaceTimeBlend)
+    {
+      if (n.align > 0)
+        alignInSpaceTime(a, b, n, shapeTime());
       part = geometry::spaceTimeBlendPart(a, b, n.spaceTime, shapeTime());
+    }
     part.kind = c.operands->kind;
     part.operandA = a;
     part.operandB = b;
@@ -220,7 +277,7 @@ std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
   // numbers change.
   const OperandNumbers n = operandNumbersOf(c);
   for (double d : { n.amount, n.spaceTime.t0, n.spaceTime.t1, n.spaceTime.a0, n.spaceTime.a1,
-         n.spaceTime.a2, n.spaceTime.a3 })
+         n.spaceTime.a2, n.spaceTime.a3, n.align })
     v = mix(v, bitsOf(d));
   for (const std::string& o : { c.operands->a, c.operands->b })
   {
@@ -279,6 +336,9 @@ bool EngineScope::lookup(const std::string& name, Value& out)
     out = Value::string(name);
     return true;
   }
+  // A cell's code names its own shape bare (thesis L3160: makeCrossSection(shape, globalT)).
+  if (name == "shape" && !cell_.empty())
+    return member(Value::cell(cell_), name, out);
   return false;
 }
 
@@ -326,6 +386,7 @@ bool EngineScope::member(const Value& base, const std::string& member, Value& ou
   {
     out.type = Value::Type::Shape;
     out.shape = m_.partsOf(spec);
+    out.text = spec.name; // whose shape: makeCrossSection and getVolume place it as that cell
     return true;
   }
   if (member == "radius")

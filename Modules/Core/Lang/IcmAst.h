@@ -241,6 +241,9 @@ struct Model
   std::vector<CellDef> animations;
   /// `cycles = previous | reevaluate | cut;`: how dependency cycles are evaluated (docs/icm.md).
   Name cycles;
+  /// `steps = keep | grow;`: after a step refined by TIME_REJECTED is accepted, keep its size
+  /// until the requested time (the default) or double it again (docs/icm.md).
+  Name steps;
   // Fragments (notation mode only): sections outside any instance.
   std::vector<RelationsSection> relations;
   std::vector<Procedure> reactions, predicates;

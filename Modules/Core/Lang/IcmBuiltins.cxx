@@ -70,6 +70,13 @@ const std::vector<Builtin>& builtins()
     { Id::SetShapeParameter, library,
       { "setShapeParameter", 3, 3, "setShapeParameter(cell, string name, real value)", "void" },
       "sets an FRep parameter (`a[1]`...) of an F-cell's HyperFun or XML shape" },
+    // Space-time cells (thesis 5.3.4, L3160-L3162).
+    { Id::MakeCrossSection, library,
+      { "makeCrossSection", 2, 2, "makeCrossSection(shape s, real t)", "shape" },
+      "the cross-section at t of a space-time cell's shape (`makeCrossSection(shape, globalT)`); "
+      "t is the time being evaluated" },
+    { Id::GetVolume, library, { "getVolume", 1, 1, "getVolume(shape s)", "real" },
+      "the volume (3D) or area (2D) of a cell's shape or cross-section, as placed now" },
     // The skeletons of skinned meshes (loadMesh cells).
     { Id::JointPosition, library,
       { "jointPosition", 2, 2, "jointPosition(cell, string joint)", "vec3" },
@@ -150,15 +157,18 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
     { Id::Union, { "union", 2, 2, "union(cellA, cellB)", "shape" }, 2,
       "the union of two cells' shapes" },
     { Id::SpaceTimeBlend,
-      { "spaceTimeBlendCells", 8, 8,
-        "spaceTimeBlendCells(cellA, cellB, real t0, real t1, real a0, real a1, real a2, real a3)",
+      { "spaceTimeBlendCells", 8, 9,
+        "spaceTimeBlendCells(cellA, cellB, real t0, real t1, real a0, real a1, real a2, real a3, "
+        "real align)",
         "shape" },
       2,
       "the space-time blend (thesis 5.3.1) of two cells' shapes of dimension k, a T-cell of "
       "`dim` k + 1: at global time t its cross-section, cellA's shape until t0, cellB's from t1, "
       "a blend of the two between, with the bounded blend's added material a0 and scales a1, a2 "
       "(the operands') and a3 (the time slab's); no defaults: they depend on the shapes' "
-      "sizes and the interval's length" },
+      "sizes and the interval's length. `align` (optional, 0 to 1; thesis 5.3.2) moves each "
+      "operand's extrusion toward the other's bounding domain during the transition, so that "
+      "at 1 they meet halfway" },
     { Id::LoadMesh, { "loadMesh", 2, 2, "loadMesh(string path, string animation)", "shape" }, 0,
       "a skinned, animated mesh (.x, .gltf, .fbx... read with Assimp; relative to the model's "
       "folder) played by the named animation at the cell's time: a B-cell surface, `dim = 2D`, "

@@ -35,6 +35,8 @@ enum class BuiltinId
   Arc,
   CircularSegment,
   SetShapeParameter,
+  MakeCrossSection,
+  GetVolume,
   JointPosition,
   Vec3,
   Length,
@@ -86,6 +88,13 @@ struct Builtin
   Signature call;
   const char* doc; ///< one line for docs/icm.md
 };
+
+/// The name a call refers to: the thesis writes the library's calls `IC::fireEvent(...)`, which is
+/// `fireEvent(...)` (and `IC::f` of a model function, `f`).
+inline std::string calledName(const std::string& text)
+{
+  return text.rfind("IC::", 0) == 0 ? text.substr(4) : text;
+}
 
 /// The reaction library, indexed by BuiltinId.
 const std::vector<Builtin>& builtins();

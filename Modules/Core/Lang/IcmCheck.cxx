@@ -41,7 +41,7 @@ bool valueType(const std::string& s, Ty& t)
   static const std::map<std::string, Ty> types = { { "real", Ty::Real }, { "REAL", Ty::Real },
     { "int", Ty::Int }, { "INT", Ty::Int }, { "bool", Ty::Bool }, { "BOOL", Ty::Bool },
     { "vec3", Ty::Vec3 }, { "VEC3", Ty::Vec3 }, { "VECTOR3", Ty::Vec3 }, { "string", Ty::String },
-    { "STRING", Ty::String } };
+    { "STRING", Ty::String }, { "shape", Ty::Shape }, { "SHAPE", Ty::Shape } };
   const auto it = types.find(s);
   if (it == types.end())
   {
@@ -127,6 +127,10 @@ void Checker::run()
   {
     err(
       m_.cycles.pos, "unknown cycle policy '" + m_.cycles.text + "' (previous, reevaluate or cut)");
+  }
+  if (!m_.steps.text.empty() && m_.steps.text != "keep" && m_.steps.text != "grow")
+  {
+    err(m_.steps.pos, "unknown step policy '" + m_.steps.text + "' (keep or grow)");
   }
   for (const CellsSection& s : m_.cells)
   {

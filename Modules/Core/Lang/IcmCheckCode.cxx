@@ -208,7 +208,7 @@ void Checker::statement(const Stmt& s, Code& c)
       Ty t = Ty::Unknown;
       if (!valueType(s.type, t))
       {
-        err(s.pos, "unknown type '" + s.type + "': real, int, bool, vec3 or string");
+        err(s.pos, "unknown type '" + s.type + "': real, int, bool, vec3, string or shape");
       }
       const Ty v = expr(s.value, c);
       if (t != Ty::Unknown && !assignable(t, v))
@@ -416,6 +416,10 @@ Ty Checker::name(const Expr& e, Code& c)
   {
     return Ty::Cell;
   }
+  if (n == "shape" && c.cell)
+  {
+    return Ty::Shape; // the cell's own shape (thesis L3160: makeCrossSection(shape, globalT))
+  }
   if (globalCells_.count(n) > 0)
   {
     err(e.pos,
@@ -618,11 +622,7 @@ Ty Checker::call(const Expr& e, Code& c)
     }
     return Ty::Unknown;
   }
-  std::string fn = e.text;
-  if (fn.rfind("IC::", 0) == 0)
-  {
-    fn = fn.substr(4);
-  }
+  const std::string fn = calledName(e.text);
   const auto uf = functions_.find(fn);
   if (uf != functions_.end())
   {

@@ -300,6 +300,13 @@ private:
       m.cycles = name("the cycle policy (previous, reevaluate or cut)");
       expect(Tok::Semi, "';'");
     }
+    else if (isWord("steps") && at(1).kind == Tok::Assign)
+    {
+      take();
+      take();
+      m.steps = name("the step policy after TIME_REJECTED (keep or grow)");
+      expect(Tok::Semi, "';'");
+    }
     else if (isWord("ANIMATIONS"))
     {
       take();
