@@ -9,6 +9,7 @@
 
 #include "FRep/Evaluators.h"
 #include "ictkFRepSampler.h"
+#include "ictkTimeSeriesWriter.h"
 
 #include <vtkCallbackCommand.h>
 #include <vtkCommand.h>
@@ -213,8 +214,11 @@ GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
   return plan;
 }
 
-vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, bool asDouble,
-  bool attributes, ictkCaptureOutputWindow* messages)
+namespace
+{
+/// The sampler of a planned grid, the one configuration of SampleImage and SampleSeries.
+vtkSmartPointer<ictkFRepSampler> PlannedSampler(
+  const GridPlan& plan, int threads, bool asDouble, bool attributes)
 {
   vtkNew<ictkFRepSampler> sampler;
   sampler->SetHypervolume(plan.Model.Model);
@@ -228,7 +232,14 @@ vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, boo
   sampler->SetNumberOfThreads(threads);
   sampler->SetOutputScalarType(asDouble ? VTK_DOUBLE : VTK_FLOAT);
   sampler->SetComputeAttributes(attributes);
+  return sampler;
+}
+} // namespace
 
+vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, bool asDouble,
+  bool attributes, ictkCaptureOutputWindow* messages)
+{
+  vtkSmartPointer<ictkFRepSampler> sampler = PlannedSampler(plan, threads, asDouble, attributes);
   ProgressBar progress("sampling " + plan.Model.Name, true);
   vtkNew<vtkCallbackCommand> onProgress;
   onProgress->SetCallback(OnProgress);
@@ -251,6 +262,40 @@ vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, boo
       std::to_string(plan.Grid.pointCount()));
   }
   return image;
+}
+
+bool SampleSeries(const GridPlan& plan, int threads, bool asDouble,
+  const std::vector<double>& times, const std::string& pvd, ictkCaptureOutputWindow* messages)
+{
+  vtkSmartPointer<ictkFRepSampler> sampler = PlannedSampler(plan, threads, asDouble, true);
+  if (!sampler->IsTimeDependent())
+  {
+    throw UserError("--frames: " + plan.Model.Name +
+      " does not depend on time (its domain has no t axis): sample it once, without --frames");
+  }
+  sampler->SetTimeSteps(times.data(), static_cast<int>(times.size()));
+  vtkNew<ictkTimeSeriesWriter> writer;
+  writer->SetInputConnection(sampler->GetOutputPort());
+  writer->SetFileName(pvd.c_str());
+  ProgressBar progress(
+    "sampling " + plan.Model.Name + " over " + std::to_string(times.size()) + " frames", true);
+  vtkNew<vtkCallbackCommand> onProgress;
+  onProgress->SetCallback(OnProgress);
+  onProgress->SetClientData(&progress);
+  writer->AddObserver(vtkCommand::ProgressEvent, onProgress);
+  const std::size_t errorsBefore = messages->Errors.size();
+  const int written = writer->Write();
+  progress.End();
+  if (Interrupted())
+  {
+    return false;
+  }
+  ThrowIfVtkFailed(messages, errorsBefore, "cannot sample the frames into '" + pvd + "'");
+  if (!written)
+  {
+    throw UserError("cannot sample the frames into '" + pvd + "'");
+  }
+  return true;
 }
 
 namespace

@@ -65,6 +65,12 @@ GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue);
 vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, bool asDouble,
   bool attributes, ictkCaptureOutputWindow* messages);
 
+/// Samples the planned grid of a time-dependent model at every time into the ParaView time series
+/// `pvd` (ictkTimeSeriesWriter: one .vti a frame, written atomically), with a progress display;
+/// false when interrupted (nothing written). A model without time is a UserError.
+bool SampleSeries(const GridPlan& plan, int threads, bool asDouble,
+  const std::vector<double>& times, const std::string& pvd, ictkCaptureOutputWindow* messages);
+
 /// Checks, before any work, that the planned grid has a surface to write to `path` (given as
 /// `option`): a grid flat along one axis (a 2D model) has a boundary curve, written as .vtp or
 /// .obj (line segments); a flatter one has none.

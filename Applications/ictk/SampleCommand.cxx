@@ -30,6 +30,7 @@ struct SampleCommandOptions : GridCommandOptions
 {
   bool Double = false;
   std::string Surface;
+  std::string Frames;
 };
 
 class SampleCommand final : public Command
@@ -41,8 +42,14 @@ public:
     o.AddTo(sample, 64);
     AddOutput(sample, o.Output, "Output image (.vti)");
     sample->add_flag("--double", o.Double, "Write double-precision arrays (default float)");
-    sample->add_option("--surface", o.Surface,
+    CLI::Option* surface = sample->add_option("--surface", o.Surface,
       "Also extract the surface f = 0 (Flying Edges) into this .vtp, .stl, .ply or .obj");
+    CLI::Option* frames = AddFrames(sample, o.Frames,
+      "a space-time model (XYZT, XYT) at every time, as a .pvd series of .vti frames (-o "
+      "name.pvd; the frames go into a folder named after it)");
+    frames->excludes(surface);
+    frames->excludes(sample->get_option("--time"));
+    frames->excludes(sample->get_option("--space-time"));
     return sample;
   }
 
@@ -53,6 +60,10 @@ public:
       throw UserError("--surface: '" + o.Surface + "' is not a " + SurfaceFormats + " file");
     }
     const GridPlan plan = PlanGrid(o, o.Double ? sizeof(double) : sizeof(float));
+    if (!o.Frames.empty())
+    {
+      return runFrames(plan);
+    }
     if (!o.Surface.empty())
     {
       CheckSurfaceGrid(plan, o.Surface, "--surface");
@@ -108,6 +119,30 @@ public:
   }
 
 private:
+  /// --frames: the grid at every time, written as a .pvd series (issue 16: a 4D field sampled
+  /// as a whole, a series of 3D frames).
+  int runFrames(const GridPlan& plan)
+  {
+    const std::vector<double> times = ParseFrames(o.Frames);
+    if (!HasExtension(o.Output, ".pvd"))
+    {
+      throw UserError("-o: with --frames the output is a .pvd series, not '" + o.Output + "'");
+    }
+    InterruptScope interrupts;
+    ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!SampleSeries(plan, o.Threads, o.Double, times, o.Output, messages))
+    {
+      std::cerr << "ictk: interrupted; nothing written\n";
+      return ExitInterrupted;
+    }
+    std::cout << "wrote " << o.Output << " (" << times.size() << " frames of " << plan.Dims[0]
+              << " x " << plan.Dims[1] << " x " << plan.Dims[2] << " points, t = " << times.front()
+              << " .. " << times.back() << ") in " << std::fixed << std::setprecision(3)
+              << Seconds(t0) << " s\n";
+    return 0;
+  }
+
   SampleCommandOptions o;
 };
 

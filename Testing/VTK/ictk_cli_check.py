@@ -827,6 +827,35 @@ K { CELLS { Ball; } }
         near(mass.GetVolume(), 4 / 3 * math.pi * r ** 3, 0.02 * 4 / 3 * math.pi * r ** 3, f"volume at t = {t}")
 
 
+def check_sample_frames(ictk, work, data):
+    """An XYZT model sampled as a whole (issue 16): --frames writes one .vti a time, each the
+    field with t bound to that frame's time, f = (0.5 + t)^2 - (x - t)^2 - y^2 - z^2 for
+    Data/Models/growing_ball.hf; a model without time and a .vti output are refused."""
+    model = os.path.join(data, "Models", "growing_ball.hf")
+    pvd = os.path.join(work, "ball.pvd")
+    run(ictk, ["sample", model, "--frames", "0:1:0.25", "--dims", "21,9,9",
+               "--bounds", "-1,2,-1,1,-1,1", "-o", pvd])
+    datasets = pvd_frames(pvd, 5, 0.25)
+    for d in datasets:
+        t = float(d.get("timestep"))
+        image = read_image(os.path.join(work, d.get("file")))
+        if image.GetDimensions() != (21, 9, 9):
+            sys.exit(f"FAIL: frame at t = {t} has dimensions {image.GetDimensions()}")
+        f = image.GetPointData().GetArray("f")
+        for i in range(0, image.GetNumberOfPoints(), 37):
+            x, y, z = image.GetPoint(i)
+            want = (0.5 + t) ** 2 - (x - t) ** 2 - y * y - z * z
+            near(f.GetValue(i), want, 1e-5, f"f at point {i}, t = {t}")
+    p = run(ictk, ["sample", "sphere", "--frames", "0:1:0.5", "-o", pvd], check=False)
+    if p.returncode != 2 or "does not depend on time" not in p.stderr:
+        sys.exit(f"FAIL: a model without time: exit {p.returncode}, stderr:\n{p.stderr}")
+    p = run(ictk, ["sample", model, "--frames", "0:1:0.5", "-o", os.path.join(work, "x.vti")],
+            check=False)
+    if p.returncode != 2 or "is a .pvd series" not in p.stderr:
+        sys.exit(f"FAIL: --frames into a .vti: exit {p.returncode}, stderr:\n{p.stderr}")
+    no_leftovers(work)
+
+
 def check_run_errors(ictk, work, data):
     """ictk run on bad input: exit 2, a clear message, and nothing written or lost."""
     model = os.path.join(data, "Models", "icm", "ch5_1_disk_rectangle.icm")
@@ -989,9 +1018,10 @@ def main():
         check_solve_bar(ictk, work, rest[0])
         print("OK")
         return
-    if check in ("run-disk", "run-errors", "run-default"):
+    if check in ("run-disk", "run-errors", "run-default", "sample-frames"):
         {"run-disk": check_run_disk, "run-errors": check_run_errors,
-         "run-default": check_run_default}[check](ictk, work, rest[0])
+         "run-default": check_run_default, "sample-frames": check_sample_frames}[check](
+            ictk, work, rest[0])
         print("OK")
         return
     if check == "complex-flower":

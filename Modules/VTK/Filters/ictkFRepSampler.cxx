@@ -187,6 +187,24 @@ const std::vector<double>& ictkFRepSampler::GetParameters() const
   return this->Internal->Model.Parameters;
 }
 
+void ictkFRepSampler::SetTimeSteps(const double* times, int count)
+{
+  std::vector<double> steps(times, times + std::max(count, 0));
+  for (std::size_t i = 0; i < steps.size(); ++i)
+  {
+    if (!std::isfinite(steps[i]) || (i > 0 && !(steps[i] > steps[i - 1])))
+    {
+      vtkErrorMacro(<< "SetTimeSteps: the times must be finite and increasing (time " << i << ")");
+      return;
+    }
+  }
+  if (steps != this->TimeSteps)
+  {
+    this->TimeSteps = std::move(steps);
+    this->Modified();
+  }
+}
+
 bool ictkFRepSampler::IsTimeDependent()
 {
   Plan plan;
@@ -292,7 +310,14 @@ int ictkFRepSampler::RequestInformation(
   outInfo->Set(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT(), 1);
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  if (plan.timeDependent)
+  if (plan.timeDependent && !this->TimeSteps.empty())
+  {
+    const double range[2] = { this->TimeSteps.front(), this->TimeSteps.back() };
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), this->TimeSteps.data(),
+      static_cast<int>(this->TimeSteps.size()));
+  }
+  else if (plan.timeDependent)
   {
     const double t0 = this->TimeRange[0], t1 = this->TimeRange[1];
     if (!std::isfinite(t0) || !std::isfinite(t1) || t1 < t0)

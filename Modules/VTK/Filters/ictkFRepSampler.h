@@ -21,7 +21,8 @@
  * a hypervolume set through SetHypervolume() has none, so ModelBounds must then be set.
  *
  * Time: a model whose domain has the t axis (XYZT, XYT, ...) is time-dependent. The output then
- * advertises TIME_RANGE (TimeRange) and TIME_STEPS (NumberOfTimeSteps evenly over it) and is
+ * advertises TIME_RANGE (TimeRange) and TIME_STEPS (NumberOfTimeSteps evenly over it, or the
+ * times SetTimeSteps() gave, whose first and last are then the range) and is
  * sampled at the pipeline's UPDATE_TIME_STEP when there is one (DATA_TIME_STEP says which), else
  * at Time. A model without t advertises no time.
  *
@@ -143,6 +144,12 @@ public:
   ///@}
 
   /**
+   * Advertises exactly these times (increasing, finite) instead of NumberOfTimeSteps over
+   * TimeRange; an empty list (count 0) goes back to those. `ictk sample --frames` sets them.
+   */
+  void SetTimeSteps(const double* times, int count);
+
+  /**
    * True when the model (resolved from the current settings) depends on t.
    */
   bool IsTimeDependent();
@@ -202,6 +209,7 @@ protected:
   double Time = 0.0;
   double TimeRange[2] = { 0.0, 1.0 };
   int NumberOfTimeSteps = 11;
+  std::vector<double> TimeSteps;
   int OutputScalarType = VTK_FLOAT;
   bool ComputeAttributes = true;
   int NumberOfThreads = 0;
