@@ -273,6 +273,33 @@ TEST(EngineExemplars, AndyhausenRunsItsWholeFilm)
   EXPECT_NEAR(real(m, "Skeleton.height"), 2.430625, 1e-4);
 }
 
+TEST(EngineExemplars, AndyhausenRopeFollowsTheBarrel)
+{
+  // The rope's hanging segment is segment(0, (0, -curLength, 0)) with curLength = 3 - 0.2 alpha =
+  // 0.6 + 0.4 t while the handle turns (alpha = 12 - 2t): its end is where the hook hangs.
+  DynamicModel m = load("andyhausen.icm");
+  for (const double t : { 0.0, 1.0, 2.5, 5.0 })
+  {
+    m.advanceTo(t, 0.25);
+    const double length = real(m, "Rope.curLength");
+    EXPECT_NEAR(length, 0.6 + 0.4 * t, 1e-9) << "t = " << t;
+    bool found = false;
+    for (const ictk::engine::CellState& c : m.cells())
+    {
+      if (c.name != "Rope")
+        continue;
+      found = true;
+      ASSERT_EQ(c.shape->parts.size(), 2u);
+      const auto& segment = c.shape->parts[0];
+      ASSERT_EQ(segment.points.size(), 2u);
+      const auto end = c.shape->place.apply(segment.points[1]);
+      EXPECT_NEAR(segment.points[1][1], -length, 1e-12) << "t = " << t;
+      EXPECT_NEAR(end[1], real(m, "Hook.translation.y"), 1e-9) << "t = " << t;
+    }
+    EXPECT_TRUE(found) << "t = " << t;
+  }
+}
+
 TEST(EngineExemplars, AndyhausenMeltingEggFollowsItsBlendRate)
 {
   // Melting_egg = blend(Liquid, Egg_contents, 0.5 * blendRate), blendRate = clamp(lifeT / 5, 0, 1)

@@ -108,6 +108,10 @@ void ModelState::build()
   if (!any)
     fail({ 1, 1 }, "the model has no IC instance (only templates)");
   buildStepper();
+  // Shapes whose constructors read parameters, now that the parameters exist.
+  for (CellSpec& c : cells)
+    if (c.shapeExpression)
+      buildShapeParts(c, *c.shapeExpression, kNone);
   // The blend-like shapes' numbers at the start; refused here, at their place, when wrong.
   for (CellSpec& c : cells)
     if (c.operands)
@@ -852,6 +856,8 @@ void ModelState::buildStepper()
       const CellSpec& spec = cells[cellIndex.at(n)];
       if (spec.operands)
         s.operandNumbers[n] = evaluateOperands(spec, s.active);
+      if (spec.shapeExpression)
+        rebuildShape(spec);
     };
     r.init = [this, n](dyn::StepContext& ctx)
     {

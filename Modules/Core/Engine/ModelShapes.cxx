@@ -12,6 +12,7 @@
 #include "FRep/Operations.h"
 
 #include <cmath>
+#include <functional>
 
 namespace ictk::engine
 {
@@ -233,6 +234,35 @@ void spaceTimeBlendShape(const ShapeCall& s)
   s.c.spaceTime = true;
 }
 
+/// Whether a `shape =` of constructors reads names (parameters) in the arguments it evaluates
+/// itself: the numbers after a blend's cells are evaluated every step anyway (evaluateOperands).
+bool readsParameters(const Property& p)
+{
+  std::function<bool(const Expr&)> reads = [&](const Expr& e)
+  {
+    if (e.kind == Expr::Kind::Name || e.kind == Expr::Kind::Member)
+      return e.text != "pi";
+    // A call's first kid is the function's name.
+    for (std::size_t i = e.kind == Expr::Kind::Call ? 1 : 0; i < e.kids.size(); ++i)
+      if (e.kids[i] && reads(*e.kids[i]))
+        return true;
+    return false;
+  };
+  if (p.isHyperFun)
+    return false;
+  for (const ExprPtr& v : p.values)
+  {
+    const lang::icm::ShapeBuiltin* shape =
+      v->kind == Expr::Kind::Call ? lang::icm::findShapeBuiltin(v->text) : nullptr;
+    if (!shape || shape->cellArguments > 0)
+      continue;
+    for (std::size_t i = 1; i < v->kids.size(); ++i)
+      if (reads(*v->kids[i]))
+        return true;
+  }
+  return false;
+}
+
 /// The engine's builders of the shape constructors (lang::icm::shapeBuiltins()).
 const std::pair<ShapeId, ShapeConstructor> kShapes[] = {
   { ShapeId::File, fileShape },
@@ -282,7 +312,18 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
     }
     return;
   }
-  EngineScope scope(*this, {}, kNone);
+  c.shapeExpression = nullptr;
+  if (readsParameters(p))
+  {
+    c.shapeExpression = &p; // built by buildModel once the parameter table exists
+    return;
+  }
+  buildShapeParts(c, p, kNone);
+}
+
+void ModelState::buildShapeParts(CellSpec& c, const Property& p, std::size_t instance)
+{
+  EngineScope scope(*this, c.name, instance);
   for (const ExprPtr& v : p.values)
   {
     if (v->kind != Expr::Kind::Call)
@@ -310,6 +351,23 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
       fail(v->pos, "unknown shape constructor '" + f + "'");
     build(ShapeCall{ *this, c, *v, f, args });
   }
+}
+
+void ModelState::rebuildShape(const CellSpec& c)
+{
+  CellSpec now;
+  now.name = c.name;
+  now.dimension = c.dimension;
+  buildShapeParts(now, *c.shapeExpression, s.active);
+  const std::vector<ShapePart>& was = *partsOf(c);
+  bool same = was.size() == now.parts.size();
+  for (std::size_t i = 0; same && i < was.size(); ++i)
+    same = was[i].kind == now.parts[i].kind && was[i].points == now.parts[i].points &&
+      was[i].size == now.parts[i].size && was[i].radius == now.parts[i].radius;
+  if (same)
+    return; // the discretisation of the shape stays valid (time coherence)
+  s.shapes[c.name] = std::make_shared<const std::vector<ShapePart>>(std::move(now.parts));
+  bumpVersion(c.name);
 }
 
 } // namespace ictk::engine

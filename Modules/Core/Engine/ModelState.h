@@ -73,6 +73,10 @@ struct CellSpec
   dyn::TimeSpan clock = dyn::TimeSpan::infinite();
   double priority = 0.0;
   std::vector<ShapePart> parts; ///< from `shape =` (empty: a T-cell set by reactions)
+  /// A `shape =` of constructors whose arguments read the cell's or the model's parameters
+  /// (`segment(vec3(0, 0, 0), vec3(0, -curLength, 0))`): built once the parameters exist and
+  /// again at every updatePost.
+  const Property* shapeExpression = nullptr;
   /// A HyperFun/XML field, kept as a tape so setShapeParameter can rebind its parameters.
   frep::TapePtr tape;
   int parameterCount = 0;
@@ -236,6 +240,11 @@ struct ModelState
   void buildEvents();
   void buildCell(const CellDef& def);
   void buildShape(CellSpec& c, const Property& p);
+  /// The parts of a `shape =` of constructors, their arguments evaluated in the cell's scope.
+  void buildShapeParts(CellSpec& c, const Property& p, std::size_t instance);
+  /// A shape whose constructors read parameters (shapeExpression), rebuilt at the cell's
+  /// updatePost; the new parts replace the old ones when they differ.
+  void rebuildShape(const CellSpec& c);
   void buildInstance(const Instance& in);
   std::vector<std::string> cellsOf(const Instance& in, int depth) const;
   std::vector<RelationSpec> relationsOf(

@@ -357,12 +357,11 @@ void Checker::shape(
         a->kind == Expr::Kind::Name ? "undefined cell '" + a->text + "'" : "expected a cell name");
     }
   }
-  // The numbers of a shape made of cells (a blend's amount, a space-time blend's parameters) are
-  // evaluated every step: they may read the cell's parameters and the model's. Other shapes are
-  // built once, from constants.
+  // The numbers of a shape are evaluated every step: they may read the cell's parameters and
+  // the model's (a blend's amount, a space-time blend's parameters, a rope's length).
   for (std::size_t i = cellArguments + 1; i < v->kids.size(); ++i)
   {
-    if (cellArguments == 0 || !owner)
+    if (!owner)
     {
       constant(v->kids[i]);
       continue;
@@ -377,10 +376,12 @@ void Checker::shape(
       code.vars.insert(name);
     }
     const Ty t = expr(v->kids[i], code);
-    if (t != Ty::Unknown && !numeric(t))
+    const bool vector = std::string(b.signature).find("vec3") != std::string::npos;
+    if (t != Ty::Unknown && !numeric(t) && !(vector && t == Ty::Vec3))
     {
       err(v->kids[i]->pos,
-        "argument " + std::to_string(i) + " of '" + v->text + "' must be a number");
+        "argument " + std::to_string(i) + " of '" + v->text + "' must be a number" +
+          (vector ? " or a vec3" : ""));
     }
   }
 }
