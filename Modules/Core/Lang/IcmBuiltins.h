@@ -36,6 +36,8 @@ enum class BuiltinId
   CircularSegment,
   SetShapeParameter,
   JointPosition,
+  JointTransforms,
+  SetDeformation,
   Vec3,
   Length,
   Dot,
@@ -111,6 +113,8 @@ enum class ShapeId
   Union,
   SpaceTimeBlend,
   LoadMesh,
+  LoadSegmentsHierarchy,
+  StandIn,
   Count ///< not a constructor: the number of them
 };
 

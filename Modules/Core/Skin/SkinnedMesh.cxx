@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace ictk::skin
@@ -220,6 +221,28 @@ std::vector<Affine> poseNodes(const SkinnedMesh& mesh, const Animation* animatio
     globals[n] = parent < 0 ? locals[n] : globals[static_cast<std::size_t>(parent)] * locals[n];
   }
   return globals;
+}
+
+std::vector<Bone> bonesOf(const SkinnedMesh& mesh)
+{
+  std::map<int, int> jointOfNode;
+  for (std::size_t j = 0; j < mesh.joints.size(); ++j)
+    jointOfNode.emplace(mesh.joints[j].node, static_cast<int>(j));
+  std::vector<Bone> out;
+  for (std::size_t j = 0; j < mesh.joints.size(); ++j)
+  {
+    int parent = mesh.nodes[static_cast<std::size_t>(mesh.joints[j].node)].parent;
+    while (parent >= 0 && !jointOfNode.count(parent))
+      parent = mesh.nodes[static_cast<std::size_t>(parent)].parent;
+    if (parent >= 0)
+      out.push_back({ jointOfNode.at(parent), static_cast<int>(j) });
+  }
+  return out;
+}
+
+Vec3 jointMarker(const SkinnedMesh& mesh, int joint)
+{
+  return mesh.joints[static_cast<std::size_t>(joint)].offset.inverse().b;
 }
 
 std::vector<Affine> jointMatrices(const SkinnedMesh& mesh, const std::vector<Affine>& globals)
