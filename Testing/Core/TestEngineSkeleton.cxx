@@ -6,7 +6,7 @@
 //
 // Two characters: glTF2/simple_skin (Debian's assimp-testmodels; small enough to pose by hand: at
 // 1 s its upper joint has turned a quarter about z and the top-left vertex (0, 2) is at
-// (-1, 0.5)), and a tube written here as glTF: a closed 1 x 2 x 1 box around three joints
+// (-1, 0.5)), and Data/Models/icm/skinned_tube.gltf, a closed 1 x 2 x 1 box around three joints
 // j0 (0, 0, 0) -> j1 (0, 1, 0) -> j2 (0, 2, 0), its lower rings weighed by j0, its upper ones
 // by j1, the middle ring half and half; over 2 s j0 moves by (2, 0, 0) and j1 turns a quarter
 // about z, so every segment of its stand-in moves rigidly with one joint.
@@ -21,7 +21,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -52,103 +51,10 @@ fs::path Write(const std::string& name, const std::string& text)
   return path;
 }
 
-std::string Base64(const std::vector<unsigned char>& bytes)
+/// The tube character (see the top of the file), shipped for the metamorphosis model.
+std::string Tube()
 {
-  static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3)
-  {
-    const unsigned v = (bytes[i] << 16) | ((i + 1 < bytes.size() ? bytes[i + 1] : 0) << 8) |
-      (i + 2 < bytes.size() ? bytes[i + 2] : 0);
-    out += digits[(v >> 18) & 63];
-    out += digits[(v >> 12) & 63];
-    out += i + 1 < bytes.size() ? digits[(v >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? digits[v & 63] : '=';
-  }
-  return out;
-}
-
-/// The tube character (see the top of the file) as a glTF file in the test's folder.
-std::string WriteTube()
-{
-  std::vector<unsigned char> buffer;
-  auto put = [&](const void* data, std::size_t n)
-  {
-    const auto* p = static_cast<const unsigned char*>(data);
-    buffer.insert(buffer.end(), p, p + n);
-  };
-  auto floats = [&](std::initializer_list<float> v)
-  {
-    for (float x : v)
-      put(&x, 4);
-  };
-  // Five rings of four vertices at y = 0, 0.5, 1, 1.5, 2, closed by two caps, outward.
-  const float corners[4][2] = { { -0.5f, -0.5f }, { 0.5f, -0.5f }, { 0.5f, 0.5f },
-    { -0.5f, 0.5f } };
-  std::vector<std::uint16_t> triangles = { 0, 1, 2, 0, 2, 3, 16, 18, 17, 16, 19, 18 };
-  for (std::uint16_t k = 0; k < 4; ++k)
-    for (std::uint16_t i = 0; i < 4; ++i)
-    {
-      const std::uint16_t a = 4 * k + i, b = 4 * k + (i + 1) % 4;
-      for (std::uint16_t v :
-        { a, std::uint16_t(b + 4), b, a, std::uint16_t(a + 4), std::uint16_t(b + 4) })
-        triangles.push_back(v);
-    }
-  put(triangles.data(), 2 * triangles.size()); // 216 bytes at 0
-  for (int k = 0; k < 5; ++k)                  // positions: 240 bytes at 216
-    for (const auto& c : corners)
-      floats({ c[0], 0.5f * k, c[1] });
-  for (int k = 0; k < 5; ++k) // joints: 80 bytes at 456
-    for (int i = 0; i < 4; ++i)
-    {
-      const unsigned char j[4] = { static_cast<unsigned char>(k < 2 ? 0 : 1), 0, 0, 0 };
-      put(j, 4);
-    }
-  for (int k = 0; k < 5; ++k) // weights: 320 bytes at 536 (the middle ring: j1 and j0 half)
-    for (int i = 0; i < 4; ++i)
-      floats({ k == 2 ? 0.5f : 1.0f, k == 2 ? 0.5f : 0.0f, 0, 0 });
-  for (float y : { 0.0f, -1.0f, -2.0f }) // inverse bind matrices: 192 bytes at 856
-    floats({ 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, y, 0, 1 });
-  floats({ 0, 2 });                                                           // times: 8 at 1048
-  floats({ 0, 0, 0, 2, 0, 0 });                                               // j0: 24 at 1056
-  floats({ 0, 0, 0, 1, 0, 0, float(std::sqrt(0.5)), float(std::sqrt(0.5)) }); // j1: 32 at 1080
-  const std::string json = R"({
-  "asset": { "version": "2.0" },
-  "scene": 0, "scenes": [ { "nodes": [ 0 ] } ],
-  "nodes": [ { "mesh": 0, "skin": 0, "children": [ 1 ] },
-    { "name": "j0", "children": [ 2 ] },
-    { "name": "j1", "translation": [ 0, 1, 0 ], "children": [ 3 ] },
-    { "name": "j2", "translation": [ 0, 1, 0 ] } ],
-  "meshes": [ { "primitives": [ { "attributes": { "POSITION": 1, "JOINTS_0": 2, "WEIGHTS_0": 3 },
-    "indices": 0 } ] } ],
-  "skins": [ { "inverseBindMatrices": 4, "joints": [ 1, 2, 3 ] } ],
-  "animations": [ { "name": "walk", "channels": [
-      { "sampler": 0, "target": { "node": 1, "path": "translation" } },
-      { "sampler": 1, "target": { "node": 2, "path": "rotation" } } ],
-    "samplers": [ { "input": 5, "output": 6, "interpolation": "LINEAR" },
-      { "input": 5, "output": 7, "interpolation": "LINEAR" } ] } ],
-  "buffers": [ { "byteLength": 1112, "uri": "data:application/octet-stream;base64,)" +
-    Base64(buffer) + R"(" } ],
-  "bufferViews": [ { "buffer": 0, "byteOffset": 0, "byteLength": 216 },
-    { "buffer": 0, "byteOffset": 216, "byteLength": 240 },
-    { "buffer": 0, "byteOffset": 456, "byteLength": 80 },
-    { "buffer": 0, "byteOffset": 536, "byteLength": 320 },
-    { "buffer": 0, "byteOffset": 856, "byteLength": 192 },
-    { "buffer": 0, "byteOffset": 1048, "byteLength": 8 },
-    { "buffer": 0, "byteOffset": 1056, "byteLength": 24 },
-    { "buffer": 0, "byteOffset": 1080, "byteLength": 32 } ],
-  "accessors": [ { "bufferView": 0, "componentType": 5123, "count": 108, "type": "SCALAR" },
-    { "bufferView": 1, "componentType": 5126, "count": 20, "type": "VEC3",
-      "min": [ -0.5, 0, -0.5 ], "max": [ 0.5, 2, 0.5 ] },
-    { "bufferView": 2, "componentType": 5121, "count": 20, "type": "VEC4" },
-    { "bufferView": 3, "componentType": 5126, "count": 20, "type": "VEC4" },
-    { "bufferView": 4, "componentType": 5126, "count": 3, "type": "MAT4" },
-    { "bufferView": 5, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [ 0 ], "max": [ 2 ] },
-    { "bufferView": 6, "componentType": 5126, "count": 2, "type": "VEC3" },
-    { "bufferView": 7, "componentType": 5126, "count": 2, "type": "VEC4" } ]
-})";
-  EXPECT_EQ(buffer.size(), 1112u);
-  return Write("tube.gltf", json).string();
+  return std::string(ICTK_DATA_DIR) + "/Models/icm/skinned_tube.gltf";
 }
 
 /// "line:col message" of the first diagnostic of loading `text`, or "no error".
@@ -269,7 +175,7 @@ TEST(EngineSkeleton, TheSkeletonsSegmentsEndAtTheJoints)
 {
   if (!skin::canReadSkinnedMeshFiles())
     GTEST_SKIP() << "built without Assimp";
-  const std::string tube = WriteTube();
+  const std::string tube = Tube();
   const std::string markers =
     "  M1 { type = P-CELL; shape = point(0, 0, 0); dim = 0D;\n"
     "    REACTIONS { update(REAL globalT, REAL localT, REAL lifeT, REAL dt) {\n"
@@ -311,7 +217,7 @@ TEST(EngineSkeleton, TheStandInFollowsTheSkeleton)
 {
   if (!skin::canReadSkinnedMeshFiles())
     GTEST_SKIP() << "built without Assimp";
-  const std::string tube = WriteTube();
+  const std::string tube = Tube();
   const std::string liquid = "  Liquid_Andy { type = F-CELL; shape = standIn(Andy); dim = 3D; }\n";
   engine::DynamicModel m = engine::DynamicModel::load(
     Write("standin.icm", SkeletonModel(tube, "walk", "globalT", liquid)).string());
@@ -400,7 +306,7 @@ TEST(EngineSkeleton, TheCheckerAndTheEngineRefuseWhatCannotWork)
 {
   if (!skin::canReadSkinnedMeshFiles())
     GTEST_SKIP() << "built without Assimp";
-  const std::string tube = WriteTube();
+  const std::string tube = Tube();
   // Two skeletons of different joint counts: at the dependency.
   std::string text = SkeletonModel(kSimpleSkin, "", "globalT");
   text.replace(text.find("loadMesh(\"" + kSimpleSkin + "\", \"\")"), 12 + kSimpleSkin.size() + 4,

@@ -207,6 +207,27 @@ Value setDeformation(const LibraryCall& call)
   return {};
 }
 
+/// setProjection(cell, alpha): how far the mesh's vertices have moved to their projections.
+Value setProjection(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const CellSpec& c = skinnedCell(call);
+  if (c.meshPart == kNone || !m.standInOf(c.name))
+    throw std::runtime_error("setProjection: no cell has the stand-in of " + c.name +
+      " (shape = standIn(" + c.name + "))");
+  const Value& v = call.args.at(1);
+  if (!v.isNumber() || !std::isfinite(v.number))
+    throw std::runtime_error("setProjection: alpha is not a finite number");
+  const double alpha = std::clamp(v.number, 0.0, 1.0);
+  const auto it = m.s.projections.find(c.name);
+  if (it == m.s.projections.end() || it->second != alpha)
+  {
+    m.s.projections[c.name] = alpha;
+    m.bumpVersion(c.name);
+  }
+  return {};
+}
+
 Value fireEvent(const LibraryCall& call)
 {
   ModelState& m = call.m;
@@ -283,6 +304,7 @@ const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
   { BuiltinId::JointPosition, jointPosition },
   { BuiltinId::JointTransforms, jointTransforms },
   { BuiltinId::SetDeformation, setDeformation },
+  { BuiltinId::SetProjection, setProjection },
 };
 
 } // namespace

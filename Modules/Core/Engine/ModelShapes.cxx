@@ -309,6 +309,8 @@ void ModelState::fitStandIns()
     {
       skin::StandIn standIn = skin::initialStandIn(*mesh.skinned);
       skin::fitStandIn(standIn, mesh.skinned->restPoints);
+      c.projection =
+        std::make_shared<const skin::Projection>(skin::projectOntoStandIn(*mesh.skinned, standIn));
       c.standIn = std::make_shared<const skin::StandIn>(std::move(standIn));
     }
     catch (const std::exception& e)

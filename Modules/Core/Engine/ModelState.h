@@ -13,6 +13,7 @@
 #include "Dynamics/Stepper.h"
 #include "Engine/DynamicModel.h"
 #include "FRep/Tape.h"
+#include "Skin/Projection.h"
 #include "Skin/SkinnedMesh.h"
 #include "Skin/StandIn.h"
 
@@ -107,12 +108,15 @@ struct CellSpec
   std::vector<skin::Bone> bones;
   mutable double posedAt = kNaN;
   mutable const void* posedBy = nullptr; ///< the deformation posed by (nullptr: the animation)
+  mutable double posedAlpha = 0;         ///< the projection's fraction posed with
   mutable std::shared_ptr<const std::vector<ShapePart>> posed;
   /// standIn(cell): the fitted stand-in of the skinned cell `standInOf` (in its bind pose), its
   /// field part cached for that cell's version.
   std::string standInOf;
   Pos standInPos;
   std::shared_ptr<const skin::StandIn> standIn;
+  /// The mesh cell's vertices projected onto the stand-in (bind pose; setProjection).
+  std::shared_ptr<const skin::Projection> projection;
   mutable std::uint64_t standInVersion = 0;
   mutable std::shared_ptr<const std::vector<ShapePart>> standInParts;
   std::vector<ParamSpec> params;
@@ -178,6 +182,8 @@ struct Structure
   std::map<std::string, Value> texts;                   ///< non-numeric parameters (strings)
   /// setDeformation(cell, transforms): the skinning matrices that pose a skinned cell.
   std::map<std::string, std::shared_ptr<const std::vector<Affine>>> deformations;
+  /// setProjection(cell, alpha): how far a skinned mesh's vertices have moved to its stand-in.
+  std::map<std::string, double> projections;
 };
 
 struct ModelState
@@ -296,6 +302,14 @@ struct ModelState
   /// A skinned cell's skinning matrices now: those of setDeformation, else its animation's at
   /// its time.
   std::vector<Affine> skinningMatrices(const CellSpec& c) const;
+  /// The standIn(cell) cell of a mesh cell (the first one), or nullptr.
+  const CellSpec* standInOf(const std::string& mesh) const
+  {
+    for (const CellSpec& c : cells)
+      if (c.standIn && c.standInOf == mesh)
+        return &c;
+    return nullptr;
+  }
   Affine localPlace(const std::string& cell) const;
   Affine place(const std::string& cell, int depth = 0) const;
   PlacedShapePtr shapeOf(const std::string& cell, int depth = 0) const;

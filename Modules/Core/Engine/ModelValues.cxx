@@ -159,12 +159,19 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
     const double t = animationTime(c);
     const auto deformation = s.deformations.find(c.name);
     const void* by = deformation == s.deformations.end() ? nullptr : deformation->second.get();
-    if (!c.posed || !(c.posedAt == t) || c.posedBy != by)
+    const auto projection = s.projections.find(c.name);
+    const double alpha = projection == s.projections.end() ? 0.0 : projection->second;
+    if (!c.posed || !(c.posedAt == t) || c.posedBy != by || c.posedAlpha != alpha)
     {
       const std::vector<Affine> matrices = skinningMatrices(c);
       auto posed = std::make_shared<std::vector<ShapePart>>(c.parts);
+      const CellSpec* standIn = alpha > 0 ? standInOf(c.name) : nullptr;
       if (c.meshPart != kNone)
-        (*posed)[c.meshPart].points = skin::skin(*c.skinned, matrices).points;
+        (*posed)[c.meshPart].points = standIn
+          ? skin::skin(*c.skinned, matrices,
+              skin::projectedRestPoints(*c.skinned, *standIn->projection, alpha))
+              .points
+          : skin::skin(*c.skinned, matrices).points;
       for (std::size_t i = 0; i < c.bones.size(); ++i)
       {
         // A bone's segment moves with its two joints.
@@ -175,6 +182,7 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
       c.posed = std::move(posed);
       c.posedAt = t;
       c.posedBy = by;
+      c.posedAlpha = alpha;
     }
     return c.posed;
   }

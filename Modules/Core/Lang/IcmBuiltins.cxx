@@ -84,6 +84,11 @@ const std::vector<Builtin>& builtins()
       { "setDeformation", 2, 2, "setDeformation(cell, transforms)", "void" },
       "poses a skinned cell by these skinning matrices (one per joint of its skeleton) instead "
       "of its animation, from now on (Appendix B's `brepCell.setDeformation(transforms)`)" },
+    { Id::SetProjection, library,
+      { "setProjection", 2, 2, "setProjection(cell, real alpha)", "void" },
+      "moves the vertices of a `loadMesh` cell the fraction alpha (0..1) of the way to their "
+      "projections onto its stand-in (the `standIn(cell)` cell of it), in the bind pose, before "
+      "skinning them (thesis 5.5's K2 and K4: p'_i = sum_j w_ij M_j (p_i + alpha dp_i))" },
     // Vectors.
     { Id::Vec3, math, { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" }, "a vector" },
     { Id::Length, math, { "length", 1, 1, "length(vec3 v)", "real" }, "the Euclidean norm" },

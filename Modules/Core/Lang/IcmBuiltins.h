@@ -38,6 +38,7 @@ enum class BuiltinId
   JointPosition,
   JointTransforms,
   SetDeformation,
+  SetProjection,
   Vec3,
   Length,
   Dot,

@@ -743,7 +743,8 @@ Ty Checker::call(const Expr& e, Code& c)
     }
   }
   const bool skeletal = builtin->id == BuiltinId::JointPosition ||
-    builtin->id == BuiltinId::JointTransforms || builtin->id == BuiltinId::SetDeformation;
+    builtin->id == BuiltinId::JointTransforms || builtin->id == BuiltinId::SetDeformation ||
+    builtin->id == BuiltinId::SetProjection;
   if (skeletal && e.kids.size() == 3)
   {
     jointPosition(e, c.cells);

@@ -256,6 +256,15 @@ std::vector<Affine> jointMatrices(const SkinnedMesh& mesh, const std::vector<Aff
 
 Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& matrices)
 {
+  return skin(mesh, matrices, mesh.restPoints);
+}
+
+Posed skin(
+  const SkinnedMesh& mesh, const std::vector<Affine>& matrices, const std::vector<Vec3>& restPoints)
+{
+  if (restPoints.size() != mesh.vertexCount())
+    throw std::invalid_argument("skin: " + std::to_string(restPoints.size()) +
+      " rest points for a mesh of " + std::to_string(mesh.vertexCount()) + " vertices");
   Posed out;
   std::size_t count = mesh.vertexCount();
   out.points.resize(count);
@@ -274,7 +283,7 @@ Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& matrices)
       for (int e = 0; e < 3; ++e)
         blended.b[e] += f.weight * m.b[e];
     }
-    out.points[i] = blended.apply(mesh.restPoints[i]);
+    out.points[i] = blended.apply(restPoints[i]);
     if (!out.normals.empty())
     {
       Affine normalMap;

@@ -151,6 +151,10 @@ struct Posed
 
 /// Linear blend skinning of the rest mesh by the given skinning matrices (one per joint).
 Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& jointMatrices);
+/// The same with other rest points (one per vertex) in place of the rest mesh's: thesis 5.5's
+/// p'_i(t) = sum_j w_ij M_j(t) f_alpha(p_i, p_i + dp_i) for vertices moved in the bind pose.
+Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& jointMatrices,
+  const std::vector<Vec3>& restPoints);
 /// The mesh posed at `seconds` into `animation` (nullptr: the bind pose).
 Posed pose(const SkinnedMesh& mesh, const Animation* animation, double seconds);
 

@@ -147,11 +147,27 @@ frep::Box3 standInBounds(const StandIn& standIn)
 
 StandIn poseStandIn(const StandIn& standIn, const std::vector<Affine>& matrices)
 {
+  // The scale of a joint's matrix: the cube root of its linear part's determinant.
+  auto scaleOf = [](const Affine& m)
+  {
+    const auto& a = m.a;
+    const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+      a[2] * (a[3] * a[7] - a[4] * a[6]);
+    return std::cbrt(std::abs(det));
+  };
   StandIn out = standIn;
   for (StandInSegment& g : out.segments)
   {
-    g.a = matrices[static_cast<std::size_t>(g.parentJoint)].apply(g.a);
-    g.b = matrices[static_cast<std::size_t>(g.joint)].apply(g.b);
+    const Affine& start = matrices[static_cast<std::size_t>(g.parentJoint)];
+    const Affine& end = matrices[static_cast<std::size_t>(g.joint)];
+    g.a = start.apply(g.a);
+    g.b = end.apply(g.b);
+    const double scale = 0.5 * (scaleOf(start) + scaleOf(end));
+    if (scale > 0 && std::isfinite(scale))
+    {
+      g.radius *= scale;
+      g.s /= scale;
+    }
   }
   return out;
 }

@@ -56,7 +56,9 @@ frep::Shape standInShape(const StandIn& standIn);
 frep::Box3 standInBounds(const StandIn& standIn);
 
 /// The stand-in posed by the mesh's skinning matrices (jointMatrices): every segment's ends
-/// moved by their joints' matrices.
+/// moved by their joints' matrices, its radius multiplied and its kernel width divided by their
+/// scale (the cube root of the determinant of their linear parts, the mean of its two ends), so
+/// that a skeleton scaled uniformly scales its stand-in (FBX files pose their meshes so).
 StandIn poseStandIn(const StandIn& standIn, const std::vector<Affine>& jointMatrices);
 
 struct StandInFitOptions
