@@ -15,6 +15,7 @@
 #include "FRep/Evaluators.h"
 #include "FRep/Primitives.h"
 #include "FRep/Tape.h"
+#include "Skin/Projection.h"
 #include "Skin/SkinFile.h"
 #include "Skin/StandIn.h"
 
@@ -23,6 +24,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -329,4 +331,98 @@ TEST(EngineSkeleton, TheCheckerAndTheEngineRefuseWhatCannotWork)
     "  REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) { setDeformation(A, 1); } } } }\n"
     "K { CELLS { A; } }\n");
   EXPECT_NE(e.find("setDeformation takes a skinned cell"), std::string::npos) << e;
+}
+
+// Data/Models/icm/metamorphosis.icm (thesis 5.5): K1 the source mesh, K2 it moving onto its
+// stand-in, K3 the space-time blend of the two stand-ins, K4 the destination leaving its
+// stand-in, K5 the destination mesh. Read here with the two stand-ins also shown in K3, so that
+// the blend can be compared with them.
+TEST(EngineSkeleton, TheMetamorphosisGoesFromTheSourceMeshToTheDestinationMesh)
+{
+  if (!skin::canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  std::ifstream in(std::string(ICTK_DATA_DIR) + "/Models/icm/metamorphosis.icm");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("\"skinned_tube.gltf\""), 19, "\"" + Tube() + "\"");
+  text.replace(text.find("CELLS { Morph; }"), 16, "CELLS { Morph Source_standIn Target_standIn; }");
+  engine::DynamicModel m = engine::DynamicModel::load(Write("metamorphosis.icm", text).string());
+  const skin::SkinnedMesh source =
+    skin::readSkinnedMesh(std::string(ICTK_ASSIMP_MODELS) + "/FBX/huesitos.fbx");
+  const skin::SkinnedMesh target = skin::readSkinnedMesh(Tube());
+  const auto sourcePlace =
+    ictk::geometry::Affine::fromTransform({ -1.6, -2.7, 2.6 }, { 0, 0, 0 }, { 0.01, 0.01, 0.01 });
+  const auto targetPlace =
+    ictk::geometry::Affine::fromTransform({ 0, -2.5, 0 }, { 0, 0, 0 }, { 2.5, 2.5, 2.5 });
+  // The projections the engine makes, made again with the library: in the bind pose every
+  // vertex ends on its stand-in (|F| < 1e-9).
+  auto projectionOf = [](const skin::SkinnedMesh& mesh)
+  {
+    skin::StandIn s = skin::initialStandIn(mesh);
+    skin::fitStandIn(s, mesh.restPoints);
+    return skin::projectOntoStandIn(mesh, s);
+  };
+  const skin::Projection sourceProjection = projectionOf(source);
+  const skin::Projection targetProjection = projectionOf(target);
+  EXPECT_EQ(sourceProjection.failures, 0);
+  EXPECT_LT(sourceProjection.maxResidual, 1e-9);
+  EXPECT_EQ(targetProjection.failures, 0);
+  EXPECT_LT(targetProjection.maxResidual, 1e-9);
+  // A mesh cell's world points against the library's skinning of the given rest points.
+  auto expectMesh = [&](const std::string& cell, const skin::SkinnedMesh& mesh,
+                      const ictk::geometry::Affine& place, double t, const std::vector<Vec3>& rest)
+  {
+    const auto cells = m.cells();
+    const auto& shape = *CellOf(cells, cell).shape;
+    const auto posed = skin::skin(
+      mesh, skin::jointMatrices(mesh, skin::poseNodes(mesh, &mesh.animations[0], t)), rest);
+    ASSERT_EQ(shape.parts[0].points.size(), posed.points.size());
+    for (std::size_t i = 0; i < posed.points.size(); ++i)
+    {
+      const Vec3 got = shape.place.apply(shape.parts[0].points[i]);
+      const Vec3 want = place.apply(posed.points[i]);
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(got[c], want[c], 1e-9 * (1 + std::abs(want[c]))) << cell << " t " << t;
+    }
+  };
+  // K1: the plain animated source.
+  m.advanceTo(0.5, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K1");
+  expectMesh("Source", source, sourcePlace, 0.5, source.restPoints);
+  // K2, alpha = 1 from t = 1.5: the source on its stand-in, still skinned.
+  m.advanceTo(1.75, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K2");
+  expectMesh(
+    "Source", source, sourcePlace, 1.75, skin::projectedRestPoints(source, sourceProjection, 1.0));
+  // K3: the blend is the source's stand-in at t0 = 2 and the destination's from t1 = 3.5 (the
+  // same inside and outside on a grid).
+  for (const auto& [t, operand] : { std::pair<double, const char*>{ 2.0, "Source_standIn" },
+         std::pair<double, const char*>{ 3.75, "Target_standIn" } })
+  {
+    m.advanceTo(t, 0.25);
+    EXPECT_EQ(m.activeInstance(), "K3");
+    const auto cells = m.cells();
+    const auto& morph = *CellOf(cells, "Morph").shape;
+    const auto& shape = *CellOf(cells, operand).shape;
+    int inside = 0;
+    for (double x = -4; x <= 4; x += 0.25)
+      for (double y = -4; y <= 4; y += 0.25)
+        for (double z = -4; z <= 4; z += 0.5)
+        {
+          const double f = shape.value({ x, y, z });
+          if (std::abs(f) < 1e-6)
+            continue;
+          inside += f > 0;
+          EXPECT_EQ(morph.value({ x, y, z }) > 0, f > 0)
+            << t << " at " << x << " " << y << " " << z;
+        }
+    EXPECT_GT(inside, 10) << t;
+  }
+  // K4, alpha = 1 until t = 4: the destination on its stand-in; K5: the plain destination.
+  m.advanceTo(4.0, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K4");
+  expectMesh(
+    "Target", target, targetPlace, 4.0, skin::projectedRestPoints(target, targetProjection, 1.0));
+  m.advanceTo(5.5, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K5");
+  expectMesh("Target", target, targetPlace, 5.5, target.restPoints);
 }
