@@ -123,6 +123,14 @@ Value Value::cell(std::string name)
   return r;
 }
 
+Value Value::transformArray(std::vector<geometry::Affine> matrices)
+{
+  Value r;
+  r.type = Type::Transforms;
+  r.transforms = std::make_shared<const std::vector<geometry::Affine>>(std::move(matrices));
+  return r;
+}
+
 std::string Value::toJson() const
 {
   switch (type)
@@ -141,6 +149,8 @@ std::string Value::toJson() const
       return quoted("shape");
     case Type::Event:
       return quoted("event");
+    case Type::Transforms:
+      return quoted(std::to_string(transforms ? transforms->size() : 0) + " transforms");
     case Type::None:
       break;
   }
@@ -169,6 +179,8 @@ const char* typeName(Value::Type t)
       return "cell";
     case Value::Type::Event:
       return "event";
+    case Value::Type::Transforms:
+      return "array of TRANSFORM";
   }
   return "?";
 }

@@ -41,14 +41,17 @@ struct Value
     String,
     Shape, ///< shape parts in local coordinates (segment(...), arc(...))
     Cell,  ///< a reference to a cell (text = its name)
-    Event  ///< an event with its parameters (react's argument)
+    Event, ///< an event with its parameters (react's argument)
+    /// An `array of TRANSFORM`: the skinning matrices of a skeleton's joints (jointTransforms).
+    Transforms
   };
   Type type = Type::None;
   double number = 0.0;
   geometry::Vec3 vec{ 0, 0, 0 };
   std::string text;
   std::shared_ptr<const std::vector<geometry::ShapePart>> shape;
-  std::map<std::string, double> fields; ///< Event parameters
+  std::map<std::string, double> fields;                            ///< Event parameters
+  std::shared_ptr<const std::vector<geometry::Affine>> transforms; ///< Transforms
 
   static Value real(double v);
   static Value integer(double v);
@@ -56,6 +59,7 @@ struct Value
   static Value vector(const geometry::Vec3& v);
   static Value string(std::string s);
   static Value cell(std::string name);
+  static Value transformArray(std::vector<geometry::Affine> matrices);
   bool isNumber() const { return type == Type::Real || type == Type::Int; }
   /// For traces: 1.5, 3, true, [1, 2, 3], "text".
   std::string toJson() const;

@@ -56,6 +56,7 @@ void ModelState::build()
         if (!cellIndex.count(def.name.text))
           buildCell(def);
   checkSpaceTimeBlends();
+  fitStandIns();
   for (const ParamDecl& p : model.stateParameters)
     if (p.kind == ParamDecl::Kind::Typed)
     {
@@ -411,7 +412,12 @@ void ModelState::buildCell(const CellDef& def)
   {
     if (p.kind != ParamDecl::Kind::Init && p.kind != ParamDecl::Kind::Typed)
       continue;
-    const ParamSpec spec{ p.pos, p.name.text, initialValue(p) };
+    ParamSpec spec{ p.pos, p.name.text, initialValue(p) };
+    // A skinned cell's `array of TRANSFORM` holds one transform per joint (Appendix B's
+    // matrices and transforms), the bind pose's identities to start with; elsewhere an array
+    // only orders dependencies.
+    if (p.array && p.type.text == "TRANSFORM" && c.skinned)
+      spec.initial = Value::transformArray(std::vector<Affine>(c.skinned->joints.size()));
     auto same = std::find_if(
       c.params.begin(), c.params.end(), [&](const ParamSpec& q) { return q.name == spec.name; });
     if (same != c.params.end())
@@ -757,6 +763,19 @@ void ModelState::addParam(const std::string& owner, const ParamSpec& p)
     case Value::Type::Bool:
       table.add(owner, p.name, dyn::Scope::Global, p.initial.number);
       break;
+    case Value::Type::Transforms:
+    {
+      transformCounts[q] = p.initial.transforms->size();
+      std::size_t k = 0;
+      for (const Affine& m : *p.initial.transforms)
+      {
+        for (double x : m.a)
+          table.add(owner, p.name + "." + std::to_string(k++), dyn::Scope::Global, x);
+        for (double x : m.b)
+          table.add(owner, p.name + "." + std::to_string(k++), dyn::Scope::Global, x);
+      }
+      break;
+    }
     default:
       s.texts[q] = p.initial;
       break;
@@ -791,7 +810,25 @@ dyn::DependencyGraph ModelState::graph(std::size_t i) const
       const Value::Type a = types.at(mq), b = types.at(dq);
       const bool numbers = a != Value::Type::Vec3 && b != Value::Type::Vec3 &&
         a != Value::Type::None && b != Value::Type::None && a != Value::Type::String &&
-        b != Value::Type::String;
+        b != Value::Type::String && a != Value::Type::Transforms && b != Value::Type::Transforms;
+      if (a == Value::Type::Transforms && b == Value::Type::Transforms)
+      {
+        // Joint by joint, number by number: both skeletons must have as many joints.
+        const std::size_t n = transformCounts.at(mq);
+        if (transformCounts.at(dq) != n)
+          fail(r.pos,
+            "the dependency " + mq + " -> " + dq + " connects " + std::to_string(n) +
+              " transforms to " + std::to_string(transformCounts.at(dq)) +
+              " (the joints of the two cells' skeletons)");
+        for (std::size_t k = 0; k < 12 * n; ++k)
+        {
+          dyn::DependencyRelation c = d;
+          c.masterParam = r.masterMember + "." + std::to_string(k);
+          c.dependentParam = r.dependentMember + "." + std::to_string(k);
+          g.addRelation(c);
+        }
+        continue;
+      }
       if (a == Value::Type::Vec3 && b == Value::Type::Vec3)
       {
         for (const char* axis : { ".x", ".y", ".z" })

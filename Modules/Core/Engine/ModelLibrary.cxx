@@ -161,26 +161,108 @@ Value getVolume(const LibraryCall& call)
   return Value::real(geometry::measure(*call.m.shapeOf(c.name), call.m.options.geometry));
 }
 
-/// jointPosition(cell, "joint"): the joint's origin posed at the cell's time, placed by the cell.
-Value jointPosition(const LibraryCall& call)
+/// The skinned cell a library call's first argument names.
+const CellSpec& skinnedCell(const LibraryCall& call)
 {
-  ModelState& m = call.m;
   const Value& cell = call.args.at(0);
   if (cell.type != Value::Type::Cell)
     throw std::runtime_error("the first argument is a cell");
-  const CellSpec& c = m.cells[m.cellIndex.at(cell.text)];
+  const CellSpec& c = call.m.cells[call.m.cellIndex.at(cell.text)];
   if (!c.skinned)
-    throw std::runtime_error("the cell " + cell.text + " is not a skinned mesh (loadMesh)");
+    throw std::runtime_error(
+      "the cell " + cell.text + " is not a skinned cell (loadMesh, loadSegmentsHierarchy)");
+  return c;
+}
+
+/// jointPosition(cell, "joint"): the joint's origin posed now, placed by the cell.
+Value jointPosition(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const CellSpec& c = skinnedCell(call);
   const std::string& joint = call.args.at(1).text;
   const auto& nodes = c.skinned->nodes;
   const auto it =
     std::find_if(nodes.begin(), nodes.end(), [&](const skin::Node& n) { return n.name == joint; });
   if (it == nodes.end())
     throw std::runtime_error("no joint named '" + joint + "' in " + c.skinned->file);
+  const int node = static_cast<int>(it - nodes.begin());
+  if (m.s.deformations.count(c.name))
+  {
+    // Posed by setDeformation: only the joints have matrices; a joint's origin is its marker
+    // carried by its own.
+    const auto& joints = c.skinned->joints;
+    const auto j = std::find_if(
+      joints.begin(), joints.end(), [&](const skin::Joint& x) { return x.node == node; });
+    if (j == joints.end())
+      throw std::runtime_error("'" + joint + "' of " + c.skinned->file +
+        " is a node but not a joint, and the cell is posed by setDeformation");
+    const int index = static_cast<int>(j - joints.begin());
+    return Value::vector(
+      m.place(c.name).apply(m.skinningMatrices(c)[static_cast<std::size_t>(index)].apply(
+        skin::jointMarker(*c.skinned, index))));
+  }
   const std::vector<Affine> globals =
     skin::poseNodes(*c.skinned, c.skinAnimation, m.animationTime(c));
-  return Value::vector(
-    m.place(cell.text).apply(globals[static_cast<std::size_t>(it - nodes.begin())].b));
+  return Value::vector(m.place(c.name).apply(globals[static_cast<std::size_t>(node)].b));
+}
+
+/// jointTransforms(cell, t): the skinning matrices of the cell's animation at t seconds.
+Value jointTransforms(const LibraryCall& call)
+{
+  const CellSpec& c = skinnedCell(call);
+  const double t = call.args.at(1).number;
+  if (!call.args.at(1).isNumber() || !std::isfinite(t))
+    throw std::runtime_error("the time is not a finite number");
+  return Value::transformArray(
+    skin::jointMatrices(*c.skinned, skin::poseNodes(*c.skinned, c.skinAnimation, t)));
+}
+
+/// setDeformation(cell, transforms): the cell is posed by these matrices from now on.
+Value setDeformation(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const CellSpec& c = skinnedCell(call);
+  const Value& v = call.args.at(1);
+  if (v.type != Value::Type::Transforms)
+    throw std::runtime_error(
+      std::string("setDeformation takes an array of TRANSFORM, not a ") + typeName(v.type));
+  if (v.transforms->size() != c.skinned->joints.size())
+    throw std::runtime_error("setDeformation: " + std::to_string(v.transforms->size()) +
+      " transforms for the " + std::to_string(c.skinned->joints.size()) + " joints of " +
+      c.skinned->file);
+  auto& current = m.s.deformations[c.name];
+  const auto same = [](const Affine& a, const Affine& b)
+  {
+    return a.a == b.a && a.b == b.b;
+  };
+  if (!current ||
+    !std::equal(current->begin(), current->end(), v.transforms->begin(), v.transforms->end(), same))
+  {
+    current = v.transforms;
+    m.bumpVersion(c.name);
+  }
+  return {};
+}
+
+/// setProjection(cell, alpha): how far the mesh's vertices have moved to their projections.
+Value setProjection(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const CellSpec& c = skinnedCell(call);
+  if (c.meshPart == kNone || !m.standInOf(c.name))
+    throw std::runtime_error("setProjection: no cell has the stand-in of " + c.name +
+      " (shape = standIn(" + c.name + "))");
+  const Value& v = call.args.at(1);
+  if (!v.isNumber() || !std::isfinite(v.number))
+    throw std::runtime_error("setProjection: alpha is not a finite number");
+  const double alpha = std::clamp(v.number, 0.0, 1.0);
+  const auto it = m.s.projections.find(c.name);
+  if (it == m.s.projections.end() || it->second != alpha)
+  {
+    m.s.projections[c.name] = alpha;
+    m.bumpVersion(c.name);
+  }
+  return {};
 }
 
 Value fireEvent(const LibraryCall& call)
@@ -259,6 +341,9 @@ const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
   { BuiltinId::MakeCrossSection, makeCrossSection },
   { BuiltinId::GetVolume, getVolume },
   { BuiltinId::JointPosition, jointPosition },
+  { BuiltinId::JointTransforms, jointTransforms },
+  { BuiltinId::SetDeformation, setDeformation },
+  { BuiltinId::SetProjection, setProjection },
 };
 
 } // namespace

@@ -8,6 +8,7 @@
 #include "Lang/HyperFun.h"
 #include "Lang/MeshFile.h"
 #include "Skin/SkinFile.h"
+#include "Skin/StandIn.h"
 
 #include "FRep/Operations.h"
 
@@ -111,41 +112,76 @@ void fileShape(const ShapeCall& s)
   }
 }
 
-/// loadMesh("file", "animation"): a skinned mesh (thesis Appendix B's Andy), its mesh part posed
-/// at the cell's time by partsOf.
-void loadMeshShape(const ShapeCall& s)
+/// Reads the skinned mesh of loadMesh / loadSegmentsHierarchy("file", "animation") into the cell
+/// with the animation it plays.
+std::shared_ptr<const skin::SkinnedMesh> readSkinned(const ShapeCall& s)
 {
   for (std::size_t i = 0; i < 2; ++i)
     if (i >= s.args.size() || s.args[i].type != Value::Type::String)
-      s.fail("loadMesh(\"path\", \"animation\") takes two strings");
+      s.fail(s.name + "(\"path\", \"animation\") takes two strings");
   const std::string path = lang::modelFilePath(s.m.model, s.args[0].text);
   try
   {
     auto mesh = std::make_shared<const skin::SkinnedMesh>(skin::readSkinnedMesh(path));
     s.c.skinAnimation = &mesh->animation(s.args[1].text);
-    ShapePart part;
-    part.kind = ShapePart::Kind::Mesh;
-    part.points = mesh->restPoints;
-    for (const auto& t : mesh->triangles)
-      part.triangles.push_back({ static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
-        static_cast<std::uint32_t>(t[2]) });
-    // The joint that weighs most on each vertex, for colouring a frame by its skeleton.
-    ictk::discretize::PointArray joint{ "DominantJoint", 1, {} },
-      weight{ "DominantJointWeight", 1, {} };
-    for (const skin::Influence& f : mesh->dominantInfluences())
-    {
-      joint.values.push_back(f.joint);
-      weight.values.push_back(f.weight);
-    }
-    part.pointData = { std::move(joint), std::move(weight) };
-    s.c.meshPart = s.c.parts.size();
-    s.c.skinned = std::move(mesh);
-    s.add(std::move(part));
+    s.c.skinned = mesh;
+    return mesh;
   }
   catch (const std::exception& e)
   {
-    s.fail(std::string("loadMesh: ") + e.what());
+    s.fail(s.name + ": " + e.what());
   }
+}
+
+/// loadMesh("file", "animation"): a skinned mesh (thesis Appendix B's Andy), its mesh part posed
+/// at the cell's time by partsOf.
+void loadMeshShape(const ShapeCall& s)
+{
+  const auto mesh = readSkinned(s);
+  ShapePart part;
+  part.kind = ShapePart::Kind::Mesh;
+  part.points = mesh->restPoints;
+  for (const auto& t : mesh->triangles)
+    part.triangles.push_back({ static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
+      static_cast<std::uint32_t>(t[2]) });
+  // The joint that weighs most on each vertex, for colouring a frame by its skeleton.
+  ictk::discretize::PointArray joint{ "DominantJoint", 1, {} },
+    weight{ "DominantJointWeight", 1, {} };
+  for (const skin::Influence& f : mesh->dominantInfluences())
+  {
+    joint.values.push_back(f.joint);
+    weight.values.push_back(f.weight);
+  }
+  part.pointData = { std::move(joint), std::move(weight) };
+  s.c.meshPart = s.c.parts.size();
+  s.add(std::move(part));
+}
+
+/// loadSegmentsHierarchy("file", "animation"): the skeleton of a skinned mesh (Appendix B's
+/// Skeleton C-cell), a segment per bone, posed at the cell's time by partsOf.
+void loadSegmentsHierarchyShape(const ShapeCall& s)
+{
+  const auto mesh = readSkinned(s);
+  s.c.bones = skin::bonesOf(*mesh);
+  if (s.c.bones.empty())
+    s.fail(s.name + ": " + mesh->file + " has no bone (a joint with a parent joint)");
+  for (const skin::Bone& b : s.c.bones)
+  {
+    ShapePart part;
+    part.kind = ShapePart::Kind::Segment;
+    part.points = { skin::jointMarker(*mesh, b.parentJoint), skin::jointMarker(*mesh, b.joint) };
+    s.add(std::move(part));
+  }
+}
+
+/// standIn(cell): the cell's field is the stand-in of a skinned mesh cell, fitted once the cells
+/// are built (ModelState::fitStandIns) and posed by partsOf.
+void standInShape(const ShapeCall& s)
+{
+  if (s.args.empty() || s.args[0].type != Value::Type::Cell)
+    s.fail("standIn takes a cell");
+  s.c.standInOf = s.args[0].text;
+  s.c.standInPos = s.expr.pos;
 }
 
 void pointShape(const ShapeCall& s)
@@ -279,9 +315,40 @@ const std::pair<ShapeId, ShapeConstructor> kShapes[] = {
   { ShapeId::Union, operandsShape<ShapePart::Kind::Union> },
   { ShapeId::SpaceTimeBlend, spaceTimeBlendShape },
   { ShapeId::LoadMesh, loadMeshShape },
+  { ShapeId::LoadSegmentsHierarchy, loadSegmentsHierarchyShape },
+  { ShapeId::StandIn, standInShape },
 };
 
 } // namespace
+
+void ModelState::fitStandIns()
+{
+  for (CellSpec& c : cells)
+  {
+    if (c.standInOf.empty())
+      continue;
+    const auto it = cellIndex.find(c.standInOf);
+    if (it == cellIndex.end())
+      fail(c.standInPos, "standIn: no cell named '" + c.standInOf + "'");
+    const CellSpec& mesh = cells[it->second];
+    if (!mesh.skinned || mesh.meshPart == kNone)
+      fail(c.standInPos,
+        "standIn takes a skinned mesh cell, and '" + c.standInOf +
+          "' is not one (shape = loadMesh(...))");
+    try
+    {
+      skin::StandIn standIn = skin::initialStandIn(*mesh.skinned);
+      skin::fitStandIn(standIn, mesh.skinned->restPoints);
+      c.projection =
+        std::make_shared<const skin::Projection>(skin::projectOntoStandIn(*mesh.skinned, standIn));
+      c.standIn = std::make_shared<const skin::StandIn>(std::move(standIn));
+    }
+    catch (const std::exception& e)
+    {
+      fail(c.standInPos, std::string("standIn: ") + e.what());
+    }
+  }
+}
 
 std::vector<ShapeId> shapeConstructors()
 {
@@ -298,7 +365,11 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
   c.skinned.reset();
   c.skinAnimation = nullptr;
   c.meshPart = kNone;
+  c.bones.clear();
   c.posed.reset();
+  c.standInOf.clear();
+  c.standIn.reset();
+  c.standInParts.reset();
   if (p.isHyperFun)
   {
     try

@@ -13,7 +13,9 @@
 #include "Dynamics/Stepper.h"
 #include "Engine/DynamicModel.h"
 #include "FRep/Tape.h"
+#include "Skin/Projection.h"
 #include "Skin/SkinnedMesh.h"
+#include "Skin/StandIn.h"
 
 #include <limits>
 #include <map>
@@ -102,12 +104,26 @@ struct CellSpec
   };
   std::optional<Operands> operands;
   /// loadMesh("file", "animation"): a skinned mesh whose part `meshPart` is posed by the
-  /// animation at the cell's time (animationTime), cached for the last time posed.
+  /// animation at the cell's time (animationTime), or by the matrices of setDeformation, cached
+  /// for the last pose. loadSegmentsHierarchy("file", "animation"): its skeleton, one segment
+  /// part per bone of `bones`, posed the same way.
   std::shared_ptr<const skin::SkinnedMesh> skinned;
   const skin::Animation* skinAnimation = nullptr;
   std::size_t meshPart = kNone;
+  std::vector<skin::Bone> bones;
   mutable double posedAt = kNaN;
+  mutable const void* posedBy = nullptr; ///< the deformation posed by (nullptr: the animation)
+  mutable double posedAlpha = 0;         ///< the projection's fraction posed with
   mutable std::shared_ptr<const std::vector<ShapePart>> posed;
+  /// standIn(cell): the fitted stand-in of the skinned cell `standInOf` (in its bind pose), its
+  /// field part cached for that cell's version.
+  std::string standInOf;
+  Pos standInPos;
+  std::shared_ptr<const skin::StandIn> standIn;
+  /// The mesh cell's vertices projected onto the stand-in (bind pose; setProjection).
+  std::shared_ptr<const skin::Projection> projection;
+  mutable std::uint64_t standInVersion = 0;
+  mutable std::shared_ptr<const std::vector<ShapePart>> standInParts;
   std::vector<ParamSpec> params;
   std::map<std::string, const Procedure*> reactions; ///< "update", "react:EVENT", ...
 };
@@ -172,6 +188,10 @@ struct Structure
   std::map<std::string, std::uint64_t> versions;
   std::map<std::string, OperandNumbers> operandNumbers; ///< evaluated at each step
   std::map<std::string, Value> texts;                   ///< non-numeric parameters (strings)
+  /// setDeformation(cell, transforms): the skinning matrices that pose a skinned cell.
+  std::map<std::string, std::shared_ptr<const std::vector<Affine>>> deformations;
+  /// setProjection(cell, alpha): how far a skinned mesh's vertices have moved to its stand-in.
+  std::map<std::string, double> projections;
 };
 
 struct ModelState
@@ -197,6 +217,9 @@ struct ModelState
   std::map<std::string, dyn::TimeSpan> timespans;
   dyn::ParameterTable table;
   std::map<std::string, Value::Type> types; ///< qualified parameter -> type
+  /// An `array of TRANSFORM` of a skinned cell: its number of transforms (the joints), each
+  /// 12 numbers of the table (`name.0` .. : the row-major linear part, then the translation).
+  std::map<std::string, std::size_t> transformCounts;
   std::unique_ptr<dyn::Stepper> stepper;
   Structure s;
   std::size_t graphInstance = kNone;
@@ -225,6 +248,8 @@ struct ModelState
   void buildTimespans();
   /// Every spaceTimeBlendCells cell is one dimension above its two operands.
   void checkSpaceTimeBlends() const;
+  /// Fits the stand-in of every standIn(cell) cell to its skinned cell's mesh (bind pose).
+  void fitStandIns();
   /// The numbers of cell c's blend-like shape evaluated in its scope within `instance` (kNone:
   /// the model's start); fails at the place of one that is not a number or out of range.
   OperandNumbers evaluateOperands(const CellSpec& c, std::size_t instance);
@@ -288,6 +313,17 @@ struct ModelState
   double animationTime(const CellSpec& c) const
   {
     return c.hasClock ? c.clock.elapsed(shapeTime()) : shapeTime();
+  }
+  /// A skinned cell's skinning matrices now: those of setDeformation, else its animation's at
+  /// its time.
+  std::vector<Affine> skinningMatrices(const CellSpec& c) const;
+  /// The standIn(cell) cell of a mesh cell (the first one), or nullptr.
+  const CellSpec* standInOf(const std::string& mesh) const
+  {
+    for (const CellSpec& c : cells)
+      if (c.standIn && c.standInOf == mesh)
+        return &c;
+    return nullptr;
   }
   Affine localPlace(const std::string& cell) const;
   Affine place(const std::string& cell, int depth = 0) const;

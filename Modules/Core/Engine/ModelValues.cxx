@@ -63,6 +63,19 @@ Value ModelState::get(const std::string& q) const
       return Value::integer(p.value(q));
     case Value::Type::Bool:
       return Value::boolean(p.value(q) != 0.0);
+    case Value::Type::Transforms:
+    {
+      std::vector<Affine> m(transformCounts.at(q));
+      std::size_t k = 0;
+      for (Affine& a : m)
+      {
+        for (double& x : a.a)
+          x = p.value(q + "." + std::to_string(k++));
+        for (double& x : a.b)
+          x = p.value(q + "." + std::to_string(k++));
+      }
+      return Value::transformArray(std::move(m));
+    }
     default:
     {
       auto it = s.texts.find(q);
@@ -106,6 +119,25 @@ void ModelState::set(const std::string& q, const Value& v)
         bad();
       p.setValue(q, v.number);
       break;
+    case Value::Type::Transforms:
+    {
+      const std::size_t n = transformCounts.at(q);
+      if (v.type != t)
+        bad();
+      if (v.transforms->size() != n)
+        throw std::runtime_error(q + " holds " + std::to_string(n) +
+          " transforms (the joints of its skeleton), not " + std::to_string(v.transforms->size()));
+      std::size_t k = 0;
+      for (const Affine& a : *v.transforms)
+        for (int i = 0; i < 12; ++i)
+        {
+          const double x = i < 9 ? a.a[static_cast<std::size_t>(i)] : a.b[i - 9];
+          if (!std::isfinite(x))
+            throw std::runtime_error(q + " would hold a number that is not finite");
+          p.setValue(q + "." + std::to_string(k++), x);
+        }
+      break;
+    }
     default:
       if (t != Value::Type::None && v.type != t)
         bad();
@@ -122,16 +154,55 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
     return it->second;
   if (c.skinned)
   {
-    // A skinned mesh posed at the cell's time; the queries of a frame ask for it many times.
+    // A skinned mesh or skeleton posed at the cell's time or by its deformation; the queries of
+    // a frame ask for it many times.
     const double t = animationTime(c);
-    if (!c.posed || !(c.posedAt == t))
+    const auto deformation = s.deformations.find(c.name);
+    const void* by = deformation == s.deformations.end() ? nullptr : deformation->second.get();
+    const auto projection = s.projections.find(c.name);
+    const double alpha = projection == s.projections.end() ? 0.0 : projection->second;
+    if (!c.posed || !(c.posedAt == t) || c.posedBy != by || c.posedAlpha != alpha)
     {
+      const std::vector<Affine> matrices = skinningMatrices(c);
       auto posed = std::make_shared<std::vector<ShapePart>>(c.parts);
-      (*posed)[c.meshPart].points = skin::pose(*c.skinned, c.skinAnimation, t).points;
+      const CellSpec* standIn = alpha > 0 ? standInOf(c.name) : nullptr;
+      if (c.meshPart != kNone)
+        (*posed)[c.meshPart].points = standIn
+          ? skin::skin(*c.skinned, matrices,
+              skin::projectedRestPoints(*c.skinned, *standIn->projection, alpha))
+              .points
+          : skin::skin(*c.skinned, matrices).points;
+      for (std::size_t i = 0; i < c.bones.size(); ++i)
+      {
+        // A bone's segment moves with its two joints.
+        std::vector<Vec3>& ends = (*posed)[i].points;
+        ends[0] = matrices[static_cast<std::size_t>(c.bones[i].parentJoint)].apply(ends[0]);
+        ends[1] = matrices[static_cast<std::size_t>(c.bones[i].joint)].apply(ends[1]);
+      }
       c.posed = std::move(posed);
       c.posedAt = t;
+      c.posedBy = by;
+      c.posedAlpha = alpha;
     }
     return c.posed;
+  }
+  if (c.standIn)
+  {
+    // The stand-in posed by its mesh cell's skinning matrices, in that cell's local frame.
+    const CellSpec& mesh = cells[cellIndex.at(c.standInOf)];
+    const std::uint64_t version = versionOf(mesh.name);
+    if (!c.standInParts || c.standInVersion != version)
+    {
+      const skin::StandIn posed = skin::poseStandIn(*c.standIn, skinningMatrices(mesh));
+      ShapePart part;
+      part.kind = ShapePart::Kind::Field;
+      part.field = frep::tapeField(
+        frep::Tape::compile(skin::standInShape(posed).function()), 0.0, std::vector<double>{});
+      part.bounds = c.hasDomain ? c.domain : skin::standInBounds(posed);
+      c.standInParts = std::make_shared<const std::vector<ShapePart>>(1, part);
+      c.standInVersion = version;
+    }
+    return c.standInParts;
   }
   auto parts = std::make_shared<std::vector<ShapePart>>(c.parts);
   if (c.fieldPart == kNone)
@@ -147,6 +218,14 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
       frep::tapeField(c.tape, c.spaceTime ? shapeTime() : 0.0, parameters);
   }
   return parts;
+}
+
+std::vector<Affine> ModelState::skinningMatrices(const CellSpec& c) const
+{
+  if (const auto it = s.deformations.find(c.name); it != s.deformations.end())
+    return *it->second;
+  return skin::jointMatrices(
+    *c.skinned, skin::poseNodes(*c.skinned, c.skinAnimation, animationTime(c)));
 }
 
 Affine ModelState::localPlace(const std::string& cell) const
@@ -236,6 +315,9 @@ PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
   shape->cell = c.name;
   shape->dimension = spaceDimension(c);
   shape->place = place(cell);
+  // A stand-in is placed with its mesh cell, then by its own placement.
+  if (c.standIn)
+    shape->place = shape->place * place(c.standInOf);
   if (c.operands && !s.shapes.count(cell))
   {
     ShapePart part;
@@ -271,6 +353,9 @@ std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
   // A skinned mesh changes with its animation's time.
   if (c.skinned)
     v = mix(v, bitsOf(animationTime(c)));
+  // A stand-in changes with its mesh cell's pose (its placement moves it whole).
+  if (c.standIn)
+    v = mix(v, versionOf(c.standInOf, depth + 1));
   if (!c.operands || s.shapes.count(cell) || depth > static_cast<int>(cells.size()))
     return v;
   // A blend or union lives in world coordinates: it changes when an operand moves, and when its

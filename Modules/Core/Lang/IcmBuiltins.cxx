@@ -80,8 +80,22 @@ const std::vector<Builtin>& builtins()
     // The skeletons of skinned meshes (loadMesh cells).
     { Id::JointPosition, library,
       { "jointPosition", 2, 2, "jointPosition(cell, string joint)", "vec3" },
-      "where a joint (a node of the skeleton, by name) of a `loadMesh` cell is now, in world "
-      "coordinates" },
+      "where a joint (a node of the skeleton, by name) of a skinned cell (`loadMesh`, "
+      "`loadSegmentsHierarchy`) is now, in world coordinates" },
+    { Id::JointTransforms, library,
+      { "jointTransforms", 2, 2, "jointTransforms(cell, real t)", "transforms" },
+      "the skinning matrices M_j = G_j(t) offset_j of a skinned cell's joints (`loadMesh`, "
+      "`loadSegmentsHierarchy`) played by its animation at t seconds: the value of an "
+      "`array of TRANSFORM` parameter (thesis Appendix B's `Skeleton.matrices`)" },
+    { Id::SetDeformation, library,
+      { "setDeformation", 2, 2, "setDeformation(cell, transforms)", "void" },
+      "poses a skinned cell by these skinning matrices (one per joint of its skeleton) instead "
+      "of its animation, from now on (Appendix B's `brepCell.setDeformation(transforms)`)" },
+    { Id::SetProjection, library,
+      { "setProjection", 2, 2, "setProjection(cell, real alpha)", "void" },
+      "moves the vertices of a `loadMesh` cell the fraction alpha (0..1) of the way to their "
+      "projections onto its stand-in (the `standIn(cell)` cell of it), in the bind pose, before "
+      "skinning them (thesis 5.5's K2 and K4: p'_i = sum_j w_ij M_j (p_i + alpha dp_i))" },
     // Vectors.
     { Id::Vec3, math, { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" }, "a vector" },
     { Id::Length, math, { "length", 1, 1, "length(vec3 v)", "real" }, "the Euclidean norm" },
@@ -173,6 +187,19 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
       "a skinned, animated mesh (.x, .gltf, .fbx... read with Assimp; relative to the model's "
       "folder) played by the named animation at the cell's time: a B-cell surface, `dim = 2D`, "
       "placed by the cell; the queries, `blend` and `union` do not take it" },
+    { Id::LoadSegmentsHierarchy,
+      { "loadSegmentsHierarchy", 2, 2, "loadSegmentsHierarchy(string path, string animation)",
+        "shape" },
+      0,
+      "the rigging skeleton of a skinned mesh file (Appendix B's `Skeleton`): one segment per "
+      "bone between its two joints' origins, posed like `loadMesh`'s mesh: a C-cell, `dim = 1D`, "
+      "placed by the cell; the queries, `blend` and `union` do not take it" },
+    { Id::StandIn, { "standIn", 1, 1, "standIn(cell)", "shape" }, 1,
+      "the implicit stand-in (thesis 5.4) of a `loadMesh` cell: one Cauchy convolution segment "
+      "per bone, the radii fitted to the mesh in its bind pose once at load, the segments posed "
+      "at every step by the cell's skinning matrices and placed with it (then by this cell's own "
+      "placement): an F-cell field, `dim = 3D`, that `blend`, `spaceTimeBlendCells` and the "
+      "queries take" },
   };
   return table;
 }

@@ -38,6 +38,9 @@ enum class BuiltinId
   MakeCrossSection,
   GetVolume,
   JointPosition,
+  JointTransforms,
+  SetDeformation,
+  SetProjection,
   Vec3,
   Length,
   Dot,
@@ -120,6 +123,8 @@ enum class ShapeId
   Union,
   SpaceTimeBlend,
   LoadMesh,
+  LoadSegmentsHierarchy,
+  StandIn,
   Count ///< not a constructor: the number of them
 };
 

@@ -742,7 +742,10 @@ Ty Checker::call(const Expr& e, Code& c)
           b->signature + ")");
     }
   }
-  if (builtin->id == BuiltinId::JointPosition && e.kids.size() == 3)
+  const bool skeletal = builtin->id == BuiltinId::JointPosition ||
+    builtin->id == BuiltinId::JointTransforms || builtin->id == BuiltinId::SetDeformation ||
+    builtin->id == BuiltinId::SetProjection;
+  if (skeletal && e.kids.size() == 3)
   {
     jointPosition(e, c.cells);
   }
@@ -761,11 +764,11 @@ void Checker::jointPosition(const Expr& call, const CellMap* cells)
   if (!load)
   {
     err(cell->pos,
-      "jointPosition takes a skinned mesh, and cell '" + cell->text +
-        "' is not one (shape = loadMesh(...))");
+      call.text + " takes a skinned cell, and cell '" + cell->text +
+        "' is not one (shape = loadMesh(...) or loadSegmentsHierarchy(...))");
     return;
   }
-  if (joint->kind != Expr::Kind::String || load->kids.size() != 3 ||
+  if (call.text != "jointPosition" || joint->kind != Expr::Kind::String || load->kids.size() != 3 ||
     load->kids[1]->kind != Expr::Kind::String)
   {
     return;

@@ -326,9 +326,15 @@ void Checker::shape(
     }
     return;
   }
-  if (shape->id == ShapeId::LoadMesh)
+  if (shape->id == ShapeId::LoadMesh || shape->id == ShapeId::LoadSegmentsHierarchy)
   {
-    loadMesh(*v);
+    // A skeleton's segments need no manifold surface.
+    loadMesh(*v, shape->id == ShapeId::LoadMesh);
+    return;
+  }
+  if (shape->id == ShapeId::StandIn)
+  {
+    standIn(*v, cells);
     return;
   }
   if (shape->cellArguments > 0)
@@ -437,7 +443,8 @@ const Expr* Checker::loadMeshOf(const std::string& name, const CellMap* cells) c
   }
   for (const ExprPtr& v : p->values)
   {
-    if (v->kind == Expr::Kind::Call && v->text == "loadMesh")
+    if (v->kind == Expr::Kind::Call &&
+      (v->text == "loadMesh" || v->text == "loadSegmentsHierarchy"))
     {
       return v.get();
     }
@@ -470,7 +477,19 @@ const skin::SkinnedMesh* Checker::skinnedMesh(const Expr& path, bool report)
   return it->second.first.get();
 }
 
-void Checker::loadMesh(const Expr& call)
+void Checker::standIn(const Expr& call, const CellMap& cells)
+{
+  const ExprPtr& cell = call.kids[1];
+  const Expr* load = cell->kind == Expr::Kind::Name ? loadMeshOf(cell->text, &cells) : nullptr;
+  if (!load || load->text != "loadMesh")
+  {
+    err(cell->pos,
+      "standIn takes a skinned mesh cell, and '" + cell->text +
+        "' is not one (shape = loadMesh(...))");
+  }
+}
+
+void Checker::loadMesh(const Expr& call, bool surface)
 {
   const ExprPtr& path = call.kids[1];
   const ExprPtr& animation = call.kids[2];
@@ -479,7 +498,7 @@ void Checker::loadMesh(const Expr& call)
   {
     if (a->kind != Expr::Kind::String)
     {
-      err(a->pos, "loadMesh(\"path\", \"animation\") takes quoted strings");
+      err(a->pos, call.text + "(\"path\", \"animation\") takes quoted strings");
       strings = false;
     }
   }
@@ -492,21 +511,25 @@ void Checker::loadMesh(const Expr& call)
   {
     return;
   }
+  // A B-cell's surface must be a manifold (complex::checkCell): many characters are not. A
+  // skeleton's segments need no surface.
   try
   {
-    // A B-cell's surface must be a manifold (complex::checkCell): many characters are not.
-    complex::ExplicitGeometry surface;
-    surface.points = mesh->restPoints;
-    for (const auto& t : mesh->triangles)
+    if (surface)
     {
-      surface.triangles.push_back({ static_cast<std::uint32_t>(t[0]),
-        static_cast<std::uint32_t>(t[1]), static_cast<std::uint32_t>(t[2]) });
+      complex::ExplicitGeometry cellSurface;
+      cellSurface.points = mesh->restPoints;
+      for (const auto& t : mesh->triangles)
+      {
+        cellSurface.triangles.push_back({ static_cast<std::uint32_t>(t[0]),
+          static_cast<std::uint32_t>(t[1]), static_cast<std::uint32_t>(t[2]) });
+      }
+      complex::checkCell(complex::explicitCell(mesh->file, 2, std::move(cellSurface)));
     }
-    complex::checkCell(complex::explicitCell(mesh->file, 2, std::move(surface)));
   }
   catch (const std::exception& e)
   {
-    err(path->pos, std::string("loadMesh: ") + e.what());
+    err(path->pos, call.text + ": " + e.what());
   }
   try
   {
@@ -514,7 +537,7 @@ void Checker::loadMesh(const Expr& call)
   }
   catch (const std::exception& e)
   {
-    err(animation->pos, std::string("loadMesh: ") + e.what());
+    err(animation->pos, call.text + ": " + e.what());
   }
 }
 

@@ -162,17 +162,21 @@ private:
   /// Whether the named cell's shape is a mesh file (file("*.obj" or "*.off")): an explicit surface
   /// that the geometric queries, blends and unions do not take.
   bool isMeshCell(const std::string& name, const CellMap* cells) const;
-  /// The `loadMesh(...)` call of the named cell's shape, or nullptr.
+  /// The `loadMesh(...)` or `loadSegmentsHierarchy(...)` call of the named cell's shape (a
+  /// skinned cell), or nullptr.
   const Expr* loadMeshOf(const std::string& name, const CellMap* cells) const;
   /// The named cell's `shape =` property (a copy's source's when it gives none), or nullptr.
   const Property* shapeOf(const std::string& name, const CellMap* cells, int depth = 0) const;
   /// loadMesh("path", "animation"): the file is read (Skin/SkinFile.h) and the animation looked
   /// up, so that what cannot work is refused here, at its place.
-  void loadMesh(const Expr& call);
+  void loadMesh(const Expr& call, bool surface = true);
+  /// standIn(cell): the cell is a loadMesh cell.
+  void standIn(const Expr& call, const CellMap& cells);
   /// The skinned mesh a loadMesh path argument names, read once; nullptr (and, when `report`, an
   /// error at the argument) when it cannot be read.
   const skin::SkinnedMesh* skinnedMesh(const Expr& path, bool report = true);
-  /// jointPosition(cell, "joint"): the cell is a loadMesh cell and its skeleton has the joint.
+  /// jointPosition(cell, "joint"): the cell is a skinned cell and its skeleton has the joint;
+  /// jointTransforms(cell, t) and setDeformation(cell, m): the cell is a skinned cell.
   void jointPosition(const Expr& call, const CellMap* cells);
   static std::string arity(const Signature& b);
 

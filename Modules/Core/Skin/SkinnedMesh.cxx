@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace ictk::skin
@@ -222,6 +223,28 @@ std::vector<Affine> poseNodes(const SkinnedMesh& mesh, const Animation* animatio
   return globals;
 }
 
+std::vector<Bone> bonesOf(const SkinnedMesh& mesh)
+{
+  std::map<int, int> jointOfNode;
+  for (std::size_t j = 0; j < mesh.joints.size(); ++j)
+    jointOfNode.emplace(mesh.joints[j].node, static_cast<int>(j));
+  std::vector<Bone> out;
+  for (std::size_t j = 0; j < mesh.joints.size(); ++j)
+  {
+    int parent = mesh.nodes[static_cast<std::size_t>(mesh.joints[j].node)].parent;
+    while (parent >= 0 && !jointOfNode.count(parent))
+      parent = mesh.nodes[static_cast<std::size_t>(parent)].parent;
+    if (parent >= 0)
+      out.push_back({ jointOfNode.at(parent), static_cast<int>(j) });
+  }
+  return out;
+}
+
+Vec3 jointMarker(const SkinnedMesh& mesh, int joint)
+{
+  return mesh.joints[static_cast<std::size_t>(joint)].offset.inverse().b;
+}
+
 std::vector<Affine> jointMatrices(const SkinnedMesh& mesh, const std::vector<Affine>& globals)
 {
   std::vector<Affine> out;
@@ -233,6 +256,15 @@ std::vector<Affine> jointMatrices(const SkinnedMesh& mesh, const std::vector<Aff
 
 Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& matrices)
 {
+  return skin(mesh, matrices, mesh.restPoints);
+}
+
+Posed skin(
+  const SkinnedMesh& mesh, const std::vector<Affine>& matrices, const std::vector<Vec3>& restPoints)
+{
+  if (restPoints.size() != mesh.vertexCount())
+    throw std::invalid_argument("skin: " + std::to_string(restPoints.size()) +
+      " rest points for a mesh of " + std::to_string(mesh.vertexCount()) + " vertices");
   Posed out;
   std::size_t count = mesh.vertexCount();
   out.points.resize(count);
@@ -251,7 +283,7 @@ Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& matrices)
       for (int e = 0; e < 3; ++e)
         blended.b[e] += f.weight * m.b[e];
     }
-    out.points[i] = blended.apply(mesh.restPoints[i]);
+    out.points[i] = blended.apply(restPoints[i]);
     if (!out.normals.empty())
     {
       Affine normalMap;

@@ -124,6 +124,19 @@ struct SkinnedMesh
   void validate() const;
 };
 
+/// A bone of the rigging skeleton: a joint and its parent joint (the joint of its node's nearest
+/// ancestor that is one), as indices into SkinnedMesh::joints.
+struct Bone
+{
+  int parentJoint = -1;
+  int joint = -1;
+};
+
+/// Every bone, in the order of the joints (a root joint has none).
+std::vector<Bone> bonesOf(const SkinnedMesh& mesh);
+/// Joint j's marker: its origin in the rest mesh's frame (offset_j^-1 applied to the origin).
+Vec3 jointMarker(const SkinnedMesh& mesh, int joint);
+
 /// The global transforms of every node at `seconds` into `animation` (nullptr: the bind pose).
 std::vector<Affine> poseNodes(const SkinnedMesh& mesh, const Animation* animation, double seconds);
 /// The skinning matrices M_j = G_j * offset_j of every joint, given the nodes' global transforms.
@@ -138,6 +151,10 @@ struct Posed
 
 /// Linear blend skinning of the rest mesh by the given skinning matrices (one per joint).
 Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& jointMatrices);
+/// The same with other rest points (one per vertex) in place of the rest mesh's: thesis 5.5's
+/// p'_i(t) = sum_j w_ij M_j(t) f_alpha(p_i, p_i + dp_i) for vertices moved in the bind pose.
+Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& jointMatrices,
+  const std::vector<Vec3>& restPoints);
 /// The mesh posed at `seconds` into `animation` (nullptr: the bind pose).
 Posed pose(const SkinnedMesh& mesh, const Animation* animation, double seconds);
 

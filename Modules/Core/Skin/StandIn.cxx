@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -79,26 +78,17 @@ private:
 
 StandIn initialStandIn(const SkinnedMesh& mesh)
 {
-  std::map<int, int> jointOfNode;
-  for (std::size_t j = 0; j < mesh.joints.size(); ++j)
-    jointOfNode.emplace(mesh.joints[j].node, static_cast<int>(j));
   double size = 0;
   for (const Vec3& p : mesh.restPoints)
     size = std::max(size, norm(sub(p, mesh.restPoints.front())));
   StandIn out;
-  for (std::size_t j = 0; j < mesh.joints.size(); ++j)
+  for (const Bone& bone : bonesOf(mesh))
   {
-    int parent = mesh.nodes[static_cast<std::size_t>(mesh.joints[j].node)].parent;
-    while (parent >= 0 && !jointOfNode.count(parent))
-      parent = mesh.nodes[static_cast<std::size_t>(parent)].parent;
-    if (parent < 0)
-      continue;
     StandInSegment g;
-    g.joint = static_cast<int>(j);
-    g.parentJoint = jointOfNode.at(parent);
-    // A joint's marker is its origin in the rest frame: offset^-1 (0).
-    g.a = mesh.joints[static_cast<std::size_t>(g.parentJoint)].offset.inverse().b;
-    g.b = mesh.joints[j].offset.inverse().b;
+    g.joint = bone.joint;
+    g.parentJoint = bone.parentJoint;
+    g.a = jointMarker(mesh, g.parentJoint);
+    g.b = jointMarker(mesh, g.joint);
     if (!(norm(sub(g.b, g.a)) > 1e-9 * size))
       continue;
     g.radius = std::numeric_limits<double>::infinity();
@@ -130,13 +120,54 @@ frep::Shape standInShape(const StandIn& standIn)
   return frep::Shape(sum - frep::Expr(1.0), frep::Domain::XYZ, "standIn");
 }
 
+frep::Box3 standInBounds(const StandIn& standIn)
+{
+  frep::Box3 box{ { std::numeric_limits<double>::infinity(),
+                    std::numeric_limits<double>::infinity(),
+                    std::numeric_limits<double>::infinity() },
+    { -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+      -std::numeric_limits<double>::infinity() } };
+  double radius = 0;
+  for (const StandInSegment& g : standIn.segments)
+  {
+    radius = std::max(radius, g.radius);
+    for (int k = 0; k < 3; ++k)
+    {
+      box.lo[k] = std::min({ box.lo[k], g.a[k], g.b[k] });
+      box.hi[k] = std::max({ box.hi[k], g.a[k], g.b[k] });
+    }
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    box.lo[k] -= 2 * radius;
+    box.hi[k] += 2 * radius;
+  }
+  return box;
+}
+
 StandIn poseStandIn(const StandIn& standIn, const std::vector<Affine>& matrices)
 {
+  // The scale of a joint's matrix: the cube root of its linear part's determinant.
+  auto scaleOf = [](const Affine& m)
+  {
+    const auto& a = m.a;
+    const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+      a[2] * (a[3] * a[7] - a[4] * a[6]);
+    return std::cbrt(std::abs(det));
+  };
   StandIn out = standIn;
   for (StandInSegment& g : out.segments)
   {
-    g.a = matrices[static_cast<std::size_t>(g.parentJoint)].apply(g.a);
-    g.b = matrices[static_cast<std::size_t>(g.joint)].apply(g.b);
+    const Affine& start = matrices[static_cast<std::size_t>(g.parentJoint)];
+    const Affine& end = matrices[static_cast<std::size_t>(g.joint)];
+    g.a = start.apply(g.a);
+    g.b = end.apply(g.b);
+    const double scale = 0.5 * (scaleOf(start) + scaleOf(end));
+    if (scale > 0 && std::isfinite(scale))
+    {
+      g.radius *= scale;
+      g.s /= scale;
+    }
   }
   return out;
 }

@@ -50,8 +50,15 @@ StandIn initialStandIn(const SkinnedMesh& mesh);
 /// The stand-in's field as an FRep shape (domain XYZ), in the frame of its segments' ends.
 frep::Shape standInShape(const StandIn& standIn);
 
+/// A box that holds the stand-in's surface: its segments' box grown by twice the largest radius
+/// (a segment alone is zero at its radius; where k segments meet their sum reaches further,
+/// each term falling at least as 1 / distance^3 beyond it).
+frep::Box3 standInBounds(const StandIn& standIn);
+
 /// The stand-in posed by the mesh's skinning matrices (jointMatrices): every segment's ends
-/// moved by their joints' matrices.
+/// moved by their joints' matrices, its radius multiplied and its kernel width divided by their
+/// scale (the cube root of the determinant of their linear parts, the mean of its two ends), so
+/// that a skeleton scaled uniformly scales its stand-in (FBX files pose their meshes so).
 StandIn poseStandIn(const StandIn& standIn, const std::vector<Affine>& jointMatrices);
 
 struct StandInFitOptions
