@@ -4,8 +4,10 @@
 // into labelled tetrahedra by the CGAL backend, every tetrahedron given a material (from the scan
 // under it, or fixed by its cell), written as a .vtu and a CalculiX/Abaqus .inp. The study's
 // settings are the complex file's "study" object; everything is checked before anything is
-// written, and the two files appear together or not at all.
+// written, and the two files appear together or not at all. With a compression (--solve or the
+// study's "solve") the mesh is also solved by CalculiX (Compression.h) before either is written.
 #include "Command.h"
+#include "Compression.h"
 #include "Models.h"
 #include "Options.h"
 #include "Output.h"
@@ -56,6 +58,8 @@ struct StudySettings
   mesh::ScanMaterialOptions materials;
   /// The deck's modulus bins, in ln E (Writers.h deckMaterials).
   double binWidth = 0.01;
+  /// The top platen's displacement of the compression case; 0: no solve.
+  double compression = 0;
 };
 
 double numberAt(const Json& j, const char* key, double fallback, const std::string& where)
@@ -141,6 +145,14 @@ StudySettings readSettings(const std::string& path)
   }
   m.poissonRatio = numberAt(s, "poisson_ratio", m.poissonRatio, where);
   m.minimumModulus = numberAt(s, "minimum_modulus", m.minimumModulus, where);
+  if (s.contains("solve"))
+  {
+    out.compression = numberAt(s["solve"], "compression", 0, where + ".solve");
+    if (!(out.compression > 0) || !std::isfinite(out.compression))
+    {
+      throw UserError(where + ".solve: \"compression\" must be a positive displacement");
+    }
+  }
   const Json fixed = s.value("fixed", Json::object());
   for (const auto& [name, f] : fixed.items())
   {
@@ -283,6 +295,8 @@ struct StudyOptions
   std::string Output;
   std::string Inp;
   double Size = 0;
+  double Solve = 0;
+  std::string Ccx = "ccx";
   bool Deterministic = false;
   bool Json = false;
   int Threads = 0;
@@ -307,6 +321,10 @@ CLI::App* StudyCommand::add(CLI::App& app)
   AddOutput(study, o.Output, "Output: the labelled mesh (.vtu)");
   study->add_option("--inp", o.Inp, "The CalculiX/Abaqus deck (default: the output with .inp)");
   AddSize(study, o.Size, "Target edge length (default: the study's \"size\")");
+  study->add_option("--solve", o.Solve,
+    "Also compress the specimen by this displacement with CalculiX (default: the study's "
+    "\"solve\"); the results go to OUTPUT-solved.vtu, CalculiX's files to OUTPUT-ccx/");
+  study->add_option("--ccx", o.Ccx, "The CalculiX executable (default: ccx on PATH)");
   study->add_flag("--deterministic", o.Deterministic, "Identical output run to run");
   AddThreads(study, o.Threads);
   AddJson(study, o.Json, "Print the report as JSON");
@@ -326,6 +344,10 @@ int StudyCommand::run()
     throw UserError("--inp: '" + inp + "' is not a .inp file");
   }
   CheckThreads(o.Threads);
+  if (o.Solve != 0 && (!(o.Solve > 0) || !std::isfinite(o.Solve)))
+  {
+    throw UserError("--solve must be a positive displacement");
+  }
   if (!mesh::hasBackend(mesh::Backend::Cgal))
   {
     throw UserError(
@@ -412,7 +434,32 @@ int StudyCommand::run()
   mesh::AbaqusOptions abaqus;
   abaqus.modulusBinWidth = settings.binWidth;
   const std::size_t deckMaterials = mesh::deckMaterials(m, settings.binWidth).size();
-  // Both files or neither: the deck into its temporary file, the .vtu, then the deck's rename.
+  // The solve first (its own files), then both study files or neither: the deck into its
+  // temporary file, the .vtu, then the deck's rename.
+  const double compression = o.Solve > 0 ? o.Solve : settings.compression;
+  const std::string stem = o.Output.substr(0, o.Output.size() - std::string(".vtu").size());
+  std::optional<CompressionReport> solved;
+  double solveSeconds = 0;
+  if (compression > 0)
+  {
+    const auto t2 = std::chrono::steady_clock::now();
+    CompressionSettings c;
+    c.displacement = compression;
+    c.binWidth = settings.binWidth;
+    c.work = stem + "-ccx";
+    c.ccx = o.Ccx;
+    c.threads = o.Threads > 0 ? o.Threads : 1;
+    c.progress = !o.Json;
+    c.heading = "ictk study " + o.Model + ": compression by " + std::to_string(compression);
+    AtomicOutput results(stem + "-solved.vtu");
+    solved = SolveCompression(m, c, results);
+    if (!solved)
+    {
+      std::cerr << "ictk: interrupted; nothing written\n";
+      return ExitInterrupted;
+    }
+    solveSeconds = Seconds(t2);
+  }
   AtomicOutput deck(inp);
   mesh::writeAbaqus(m, deck.Path(), abaqus);
   WriteTetMeshVtu(m, o.Output);
@@ -433,6 +480,19 @@ int StudyCommand::run()
     j["deck_materials"] = deckMaterials;
     j["min_modulus"] = moduli.minModulus;
     j["max_modulus"] = moduli.maxModulus;
+    if (solved)
+    {
+      const auto& r = solved->result;
+      j["solved"] = stem + "-solved.vtu";
+      j["compression"] = compression;
+      j["apparent_modulus"] = r.apparentModulus;
+      j["voigt_modulus"] = r.compression.voigtModulus;
+      j["reuss_modulus"] = r.compression.reussModulus;
+      j["max_von_mises"] = solved->largestVonMises;
+      j["ccx_seconds"] = r.run.seconds;
+      j["solve_seconds"] = solveSeconds;
+    }
+    j["seconds"] = Seconds(t0);
     j["materials"] = Json::array();
     for (const auto& mq : q.materials)
     {
@@ -449,6 +509,15 @@ int StudyCommand::run()
             << deckMaterials << " materials in the deck (" << 100 * settings.binWidth
             << " % bins in ln E)\n"
             << mesh::formatQualityReport(q);
+  if (solved)
+  {
+    const auto& r = solved->result;
+    std::cout << "compressed by " << compression << ": apparent modulus " << r.apparentModulus
+              << " MPa (Reuss " << r.compression.reussModulus << ", Voigt "
+              << r.compression.voigtModulus << "), largest von Mises " << solved->largestVonMises
+              << "; ccx " << r.run.seconds << " s; results in " << stem << "-solved.vtu\n";
+  }
+  std::cout << "total " << Seconds(t0) << " s\n";
   return 0;
 }
 
