@@ -117,7 +117,7 @@ TEST(FieldOperations, BoundsEncloseAndCertify)
     }
   }
   // Far from the ball and the pin both operands are negative: the union is certified outside
-  // (by monotonicity: the interval extension of the R-union alone gives [-2.9, +0.6] here).
+  // (by monotonicity: the interval extension of the R-union alone gives [-10.9, +7.5] here).
   const frep::Box3 far{ { 0, 3.2, 3.2 }, { 0.8, 4, 4 } };
   EXPECT_TRUE(fields[0]->evaluator()->bound(far).negative());
   EXPECT_TRUE(fields[1]->evaluator()->bound(far).negative());
