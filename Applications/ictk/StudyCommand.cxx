@@ -12,6 +12,7 @@
 #include "Options.h"
 #include "Output.h"
 #include "ProgressDisplay.h"
+#include "Study.h"
 
 #include "Mesh/Backends/Backends.h"
 #include "Mesh/Quality.h"
@@ -348,95 +349,21 @@ int StudyCommand::run()
   {
     throw UserError("--solve must be a positive displacement");
   }
-  if (!mesh::hasBackend(mesh::Backend::Cgal))
-  {
-    throw UserError(
-      "the study needs the CGAL backend (configure with ICTK_ENABLE_GPL_BACKENDS=ON)");
-  }
   const auto t0 = std::chrono::steady_clock::now();
-  const StudySettings settings = readSettings(o.Model);
-  const complex::Complex k = LoadComplex(o.Model);
-  checkImplants(k, settings);
-  std::vector<std::string> cells;
-  for (complex::CellId id : k.cellsOfDimension(3))
-  {
-    cells.push_back(k.cell(id).name);
-  }
-  try
-  {
-    mesh::checkScanMaterials(settings.materials, cells);
-  }
-  catch (const std::exception& e)
-  {
-    throw UserError("'" + o.Model + "': study: " + e.what());
-  }
-  std::shared_ptr<voxel::VoxelGrid> grid;
-  try
-  {
-    grid = voxel::readCoreVolume(settings.scanFile, settings.scanArray);
-  }
-  catch (const std::exception& e)
-  {
-    throw UserError(std::string("study: the scan's Hounsfield units: ") + e.what());
-  }
-  const double readSeconds = Seconds(t0);
-  // CGAL 5.5 cannot resolve two protected curves closer than about its protecting balls (the
-  // size): issue 15 met runs that never finish, and here a 0.1 mm shell at size 1 came out with
-  // 8 % of its volume. Refuse such a study rather than write a wrong mesh.
-  const double size = o.Size > 0 ? o.Size : settings.size;
-  CheckSize(size);
-#ifdef ICTK_HAVE_MESH_CGAL
-  {
-    mesh::TetraOptions trace;
-    trace.size = size;
-    trace.threads = o.Threads;
-    const CurveGap gap =
-      closestCurves(implantCurves(k, settings, mesh::cgalFeatureCurves(k, trace), size), size);
-    if (gap.distance < kSmallestGap * size)
-    {
-      std::ostringstream m;
-      m << "study: the implants' protected curves come " << gap.distance << " apart near ("
-        << gap.at[0] << ", " << gap.at[1] << ", " << gap.at[2] << "), under " << kSmallestGap
-        << " of the size " << size << ": the CGAL backend would lose the layer between them or "
-        << "not finish; use --size " << gap.distance / kSmallestGap << " or less";
-      throw UserError(m.str());
-    }
-  }
-#endif
-  mesh::TetraOptions options;
-  options.size = size;
-  options.deterministic = o.Deterministic;
-  options.threads = o.Threads;
-  ProgressBar bar("study", false, !o.Json);
-  options.progress = [&](double fraction)
-  {
-    bar.Show(fraction);
-    return true;
-  };
-  mesh::ValidityReport validity;
-  const auto t1 = std::chrono::steady_clock::now();
-  mesh::TetMesh m = [&]
-  {
-    try
-    {
-      return mesh::tetrahedralize(k, mesh::Backend::Cgal, options, &validity);
-    }
-    catch (...)
-    {
-      bar.End();
-      throw;
-    }
-  }();
-  bar.End();
-  const double meshSeconds = Seconds(t1);
-  const mesh::ScanMaterialSummary moduli =
-    mesh::assignScanMaterials(m, *voxel::voxelField(grid, 0), settings.materials);
+  StudyRequest request;
+  request.model = o.Model;
+  request.size = o.Size;
+  request.threads = o.Threads;
+  request.deterministic = o.Deterministic;
+  request.progress = !o.Json;
+  StudyMesh study = MakeStudyMesh(request);
+  const mesh::TetMesh& m = study.mesh;
   mesh::AbaqusOptions abaqus;
-  abaqus.modulusBinWidth = settings.binWidth;
-  const std::size_t deckMaterials = mesh::deckMaterials(m, settings.binWidth).size();
+  abaqus.modulusBinWidth = study.binWidth;
+  const std::size_t deckMaterials = mesh::deckMaterials(m, study.binWidth).size();
   // The solve first (its own files), then both study files or neither: the deck into its
   // temporary file, the .vtu, then the deck's rename.
-  const double compression = o.Solve > 0 ? o.Solve : settings.compression;
+  const double compression = o.Solve > 0 ? o.Solve : study.compression;
   const std::string stem = o.Output.substr(0, o.Output.size() - std::string(".vtu").size());
   std::optional<CompressionReport> solved;
   double solveSeconds = 0;
@@ -445,7 +372,7 @@ int StudyCommand::run()
     const auto t2 = std::chrono::steady_clock::now();
     CompressionSettings c;
     c.displacement = compression;
-    c.binWidth = settings.binWidth;
+    c.binWidth = study.binWidth;
     c.work = stem + "-ccx";
     c.ccx = o.Ccx;
     c.threads = o.Threads > 0 ? o.Threads : 1;
@@ -470,16 +397,17 @@ int StudyCommand::run()
     Json j;
     j["output"] = o.Output;
     j["inp"] = inp;
-    j["size"] = options.size;
-    j["read_seconds"] = readSeconds;
-    j["mesh_seconds"] = meshSeconds;
+    j["size"] = study.size;
+    j["read_seconds"] = study.readSeconds;
+    j["mesh_seconds"] = study.meshSeconds;
+    j["material_seconds"] = study.materialSeconds;
     j["points"] = q.points;
     j["tetrahedra"] = q.tetrahedra;
     j["min_dihedral_degrees"] = q.minDihedralDegrees;
     j["min_dihedral_percentile1_degrees"] = q.minDihedralPercentile1Degrees;
     j["deck_materials"] = deckMaterials;
-    j["min_modulus"] = moduli.minModulus;
-    j["max_modulus"] = moduli.maxModulus;
+    j["min_modulus"] = study.minModulus;
+    j["max_modulus"] = study.maxModulus;
     if (solved)
     {
       const auto& r = solved->result;
@@ -503,10 +431,10 @@ int StudyCommand::run()
     return 0;
   }
   std::cout << "wrote " << o.Output << " and " << inp << " (" << q.tetrahedra
-            << " tetrahedra, size " << options.size << "; scan read in " << readSeconds
-            << " s, meshed in " << meshSeconds << " s)\n"
-            << "scan moduli " << moduli.minModulus << " to " << moduli.maxModulus << " MPa; "
-            << deckMaterials << " materials in the deck (" << 100 * settings.binWidth
+            << " tetrahedra, size " << study.size << "; scan read in " << study.readSeconds
+            << " s, meshed in " << study.meshSeconds << " s)\n"
+            << "scan moduli " << study.minModulus << " to " << study.maxModulus << " MPa; "
+            << deckMaterials << " materials in the deck (" << 100 * study.binWidth
             << " % bins in ln E)\n"
             << mesh::formatQualityReport(q);
   if (solved)
@@ -522,6 +450,102 @@ int StudyCommand::run()
 }
 
 } // namespace
+
+StudyMesh MakeStudyMesh(const StudyRequest& r)
+{
+  if (!mesh::hasBackend(mesh::Backend::Cgal))
+  {
+    throw UserError(
+      "the study needs the CGAL backend (configure with ICTK_ENABLE_GPL_BACKENDS=ON)");
+  }
+  StudyMesh out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const StudySettings settings = readSettings(r.model);
+  const complex::Complex k = LoadComplex(r.model);
+  checkImplants(k, settings);
+  std::vector<std::string> cells;
+  for (complex::CellId id : k.cellsOfDimension(3))
+  {
+    cells.push_back(k.cell(id).name);
+  }
+  try
+  {
+    mesh::checkScanMaterials(settings.materials, cells);
+  }
+  catch (const std::exception& e)
+  {
+    throw UserError("'" + r.model + "': study: " + e.what());
+  }
+  std::shared_ptr<voxel::VoxelGrid> grid;
+  try
+  {
+    grid = voxel::readCoreVolume(settings.scanFile, settings.scanArray);
+  }
+  catch (const std::exception& e)
+  {
+    throw UserError(std::string("study: the scan's Hounsfield units: ") + e.what());
+  }
+  out.readSeconds = Seconds(t0);
+  // CGAL 5.5 cannot resolve two protected curves closer than about its protecting balls (the
+  // size): issue 15 met runs that never finish, and here a 0.1 mm shell at size 1 came out with
+  // 8 % of its volume. Refuse such a study rather than write a wrong mesh.
+  const double size = r.size > 0 ? r.size : settings.size;
+  CheckSize(size);
+#ifdef ICTK_HAVE_MESH_CGAL
+  {
+    mesh::TetraOptions trace;
+    trace.size = size;
+    trace.threads = r.threads;
+    const CurveGap gap =
+      closestCurves(implantCurves(k, settings, mesh::cgalFeatureCurves(k, trace), size), size);
+    if (gap.distance < kSmallestGap * size)
+    {
+      std::ostringstream m;
+      m << "study: the implants' protected curves come " << gap.distance << " apart near ("
+        << gap.at[0] << ", " << gap.at[1] << ", " << gap.at[2] << "), under " << kSmallestGap
+        << " of the size " << size << ": the CGAL backend would lose the layer between them or "
+        << "not finish; use --size " << gap.distance / kSmallestGap << " or less";
+      throw UserError(m.str());
+    }
+  }
+#endif
+  mesh::TetraOptions options;
+  options.size = size;
+  options.deterministic = r.deterministic;
+  options.threads = r.threads;
+  ProgressBar bar("study", false, r.progress);
+  options.progress = [&](double fraction)
+  {
+    bar.Show(fraction);
+    return true;
+  };
+  mesh::ValidityReport validity;
+  const auto t1 = std::chrono::steady_clock::now();
+  out.mesh = [&]
+  {
+    try
+    {
+      return mesh::tetrahedralize(k, mesh::Backend::Cgal, options, &validity);
+    }
+    catch (...)
+    {
+      bar.End();
+      throw;
+    }
+  }();
+  bar.End();
+  out.meshSeconds = Seconds(t1);
+  const auto t2 = std::chrono::steady_clock::now();
+  const mesh::ScanMaterialSummary moduli =
+    mesh::assignScanMaterials(out.mesh, *voxel::voxelField(grid, 0), settings.materials);
+  out.materialSeconds = Seconds(t2);
+  out.minModulus = moduli.minModulus;
+  out.maxModulus = moduli.maxModulus;
+  out.size = size;
+  out.binWidth = settings.binWidth;
+  out.compression = settings.compression;
+  return out;
+}
 
 std::unique_ptr<Command> studyCommand()
 {
