@@ -144,6 +144,39 @@ using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_ta
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
 
+/// The backend's criteria at `size`.
+Criteria criteriaFor(double size)
+{
+  namespace p = CGAL::parameters;
+  return Criteria(p::edge_size = size, p::facet_angle = 25, p::facet_size = 0.75 * size,
+    p::facet_distance = 0.1 * size, p::cell_radius_edge_ratio = 3, p::cell_size = 0.8 * size);
+}
+
+/// The tetrahedra of the complex and their points, numbered in the order met.
+void extract(
+  const C3t3& c3t3, std::vector<Point3>& points, std::vector<std::array<std::uint32_t, 4>>& tets)
+{
+  points.clear();
+  tets.clear();
+  std::unordered_map<const void*, std::uint32_t> index;
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
+  {
+    std::array<std::uint32_t, 4> t{};
+    for (int k = 0; k < 4; ++k)
+    {
+      const auto [it, added] =
+        index.emplace(&*c->vertex(k), static_cast<std::uint32_t>(points.size()));
+      if (added)
+      {
+        const auto& wp = c3t3.triangulation().point(c, k);
+        points.push_back({ wp.x(), wp.y(), wp.z() });
+      }
+      t[k] = it->second;
+    }
+    tets.push_back(t);
+  }
+}
+
 void plainCgal(benchmark::State& state, double size, bool deterministic)
 {
   std::vector<Point3> points;
@@ -187,31 +220,12 @@ void plainCgal(benchmark::State& state, double size, bool deterministic)
     }
     domain.add_features(edges.begin(), edges.end());
     namespace p = CGAL::parameters;
-    Criteria criteria(p::edge_size = size, p::facet_angle = 25, p::facet_size = 0.75 * size,
-      p::facet_distance = 0.1 * size, p::cell_radius_edge_ratio = 3, p::cell_size = 0.8 * size);
+    const Criteria criteria = criteriaFor(size);
     C3t3 c3t3 = deterministic
       ? CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_perturb(), p::no_exude())
       : CGAL::make_mesh_3<C3t3>(
           domain, criteria, p::perturb(p::sliver_bound = 12), p::exude(p::sliver_bound = 12));
-    points.clear();
-    tets.clear();
-    std::unordered_map<const void*, std::uint32_t> index;
-    for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
-    {
-      std::array<std::uint32_t, 4> t{};
-      for (int k = 0; k < 4; ++k)
-      {
-        const auto [it, added] =
-          index.emplace(&*c->vertex(k), static_cast<std::uint32_t>(points.size()));
-        if (added)
-        {
-          const auto& wp = c3t3.triangulation().point(c, k);
-          points.push_back({ wp.x(), wp.y(), wp.z() });
-        }
-        t[k] = it->second;
-      }
-      tets.push_back(t);
-    }
+    extract(c3t3, points, tets);
     benchmark::DoNotOptimize(tets.data());
   }
   report(state, points, tets);
@@ -336,28 +350,9 @@ void plainCgalCt(benchmark::State& state)
     }
     domain.add_features(edges.begin(), edges.end());
     namespace p = CGAL::parameters;
-    Criteria criteria(p::edge_size = size, p::facet_angle = 25, p::facet_size = 0.75 * size,
-      p::facet_distance = 0.1 * size, p::cell_radius_edge_ratio = 3, p::cell_size = 0.8 * size);
+    const Criteria criteria = criteriaFor(size);
     C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_perturb(), p::no_exude());
-    points.clear();
-    tets.clear();
-    std::unordered_map<const void*, std::uint32_t> index;
-    for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
-    {
-      std::array<std::uint32_t, 4> t{};
-      for (int k = 0; k < 4; ++k)
-      {
-        const auto [it, added] =
-          index.emplace(&*c->vertex(k), static_cast<std::uint32_t>(points.size()));
-        if (added)
-        {
-          const auto& wp = c3t3.triangulation().point(c, k);
-          points.push_back({ wp.x(), wp.y(), wp.z() });
-        }
-        t[k] = it->second;
-      }
-      tets.push_back(t);
-    }
+    extract(c3t3, points, tets);
     benchmark::DoNotOptimize(tets.data());
   }
   report(state, points, tets);

@@ -12,11 +12,7 @@ namespace ictk::frep
 namespace
 {
 constexpr double pi = 3.14159265358979323846;
-
-using detail::fail;
-using detail::requireFinite;
-using detail::requirePositive;
-using detail::show;
+using namespace detail;
 
 /// The distance to the z axis in an implant's own frame.
 Expr radial()
