@@ -977,6 +977,37 @@ def check_study(ictk, work, data):
         sys.exit("FAIL: negative pitch: output written despite the error")
 
 
+def check_study_implants(ictk, work, data):
+    """ictk study on ct-implants.json (issue 15): the screw, the plate and the scaffold mesh into
+    their labels with the volumes of their formulas, and the study file's own "solve" runs
+    CalculiX: E_app between the deck's Reuss and Voigt bounds."""
+    if not os.path.exists(CRANIUM):
+        sys.exit(f"FAIL: {CRANIUM} is missing: install invesalius-examples (Scripts/setup does)")
+    if not shutil.which("ccx"):
+        sys.exit("FAIL: ccx is missing: install calculix-ccx (Scripts/setup does)")
+    model = os.path.join(data, "Studies", "ct-implant", "ct-implants.json")
+    report = json.loads(run(ictk, ["study", model, "-o", os.path.join(work, "imp.vtu"), "--deterministic",
+                                   "--threads", "2", "--json"]).stdout)
+    volumes = {m["name"]: m["volume"] for m in report["materials"]}
+    if sorted(volumes) != sorted(["soft", "bone", "screw", "screw_shell", "plate", "plate_shell", "scaffold",
+                                  "scaffold_shell"]):
+        sys.exit(f"FAIL: labels {sorted(volumes)}")
+    # The screw: pi E[r^2] L with r uniform in [1.5, 2.5] along the thread: 6 pi (2.25 + 1.5 + 1/3).
+    screw = 6 * math.pi * (2.25 + 1.5 + 1 / 3)
+    plate = 12 * 6 * 1.5 - 2 * math.pi * 1.25 ** 2 * 1.5
+    plate_shell = 13 * 7 * 2.5 - 2 * math.pi * 0.75 ** 2 * 2.5 - plate
+    for name, expected, tolerance in (("screw", screw, 0.02), ("plate", plate, 0.01),
+                                      ("plate_shell", plate_shell, 0.01)):
+        if abs(volumes[name] / expected - 1) > tolerance:
+            sys.exit(f"FAIL: {name} volume {volumes[name]} against {expected} (tolerance {tolerance})")
+    near(sum(volumes.values()), 24 * 24 * 6, 0.001 * 24 * 24 * 6, "total volume")
+    if not report["reuss_modulus"] <= report["apparent_modulus"] <= report["voigt_modulus"]:
+        sys.exit(f"FAIL: E_app {report['apparent_modulus']} outside [Reuss, Voigt] = "
+                 f"[{report['reuss_modulus']}, {report['voigt_modulus']}]")
+    if not os.path.exists(os.path.join(work, "imp-solved.vtu")):
+        sys.exit("FAIL: no imp-solved.vtu")
+
+
 def parse_arguments(usage):
     """--ictk PATH --work DIR CHECK [ARGS...] -> (ictk, work, check, args), with an empty work
     folder. Parsed by hand: the patterns and ictk arguments start with "--" themselves."""
@@ -1007,6 +1038,10 @@ def main():
     }
     if check == "study":
         check_study(ictk, work, rest[0])
+        print("OK")
+        return
+    if check == "study-implants":
+        check_study_implants(ictk, work, rest[0])
         print("OK")
         return
     if check == "tetra-bar":
