@@ -4,6 +4,7 @@
 // solve, the results as a .vtu (displacement, stress, von Mises) and the apparent modulus
 // between its Voigt and Reuss bounds.
 #include "Command.h"
+#include "Compression.h"
 #include "Options.h"
 #include "Output.h"
 #include "ProgressDisplay.h"
@@ -108,49 +109,28 @@ int SolveCommand::run()
   }
   const mesh::TetMesh m = ictk::vtk::tetMeshFromVTK(reader->GetOutput(), o.Mesh);
   AtomicOutput file(o.Output);
-  const std::string work = o.Work.empty()
+  CompressionSettings settings;
+  settings.work = o.Work.empty()
     ? o.Output.substr(0, o.Output.size() - std::string(".vtu").size()) + "-ccx"
     : o.Work;
-
-  mesh::CompressionOptions compression;
-  compression.displacement = o.Compression;
-  compression.modulusBinWidth = o.BinWidth;
-  compression.heading =
-    "ictk solve " + o.Mesh + ": compression by " + std::to_string(o.Compression);
-  mesh::CalculixOptions calculix;
-  calculix.executable = o.Ccx;
-  calculix.threads =
+  const std::string& work = settings.work;
+  settings.displacement = o.Compression;
+  settings.binWidth = o.BinWidth;
+  settings.heading = "ictk solve " + o.Mesh + ": compression by " + std::to_string(o.Compression);
+  settings.ccx = o.Ccx;
+  settings.threads =
     o.Threads > 0 ? o.Threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  InterruptScope interrupts;
-  ProgressBar bar("ccx", false, !o.Json);
-  calculix.progress = [&](double fraction)
+  settings.progress = !o.Json;
+  const std::optional<CompressionReport> report = SolveCompression(m, settings, file);
+  if (!report)
   {
-    bar.Show(fraction);
-    return !Interrupted();
-  };
-  mesh::CompressionResult r;
-  try
-  {
-    r = mesh::solveCompression(m, work, compression, calculix);
-  }
-  catch (const Cancelled&)
-  {
-    bar.End();
     std::cerr << "ictk: interrupted; nothing written\n";
     return ExitInterrupted;
   }
-  bar.End();
-  const mesh::PointResults results = mesh::resultsOnMesh(m, mesh::readFrd(r.run.frd));
-  vtkNew<vtkUnstructuredGrid> grid;
-  ictk::vtk::solverResultsToVTK(m, results, r.compression.materials, grid);
-  WriteUnstructuredGrid(grid, file);
+  const mesh::CompressionResult& r = report->result;
   const double seconds = Seconds(t0);
   const auto& c = r.compression;
-  double largest = 0;
-  for (const double v : results.vonMises)
-  {
-    largest = std::max(largest, v);
-  }
+  const double largest = report->largestVonMises;
   if (o.Json)
   {
     nlohmann::json j;
@@ -183,6 +163,45 @@ int SolveCommand::run()
 }
 
 } // namespace
+
+std::optional<CompressionReport> SolveCompression(
+  const mesh::TetMesh& m, const CompressionSettings& settings, AtomicOutput& file)
+{
+  mesh::CompressionOptions compression;
+  compression.displacement = settings.displacement;
+  compression.modulusBinWidth = settings.binWidth;
+  compression.heading = settings.heading;
+  mesh::CalculixOptions calculix;
+  calculix.executable = settings.ccx;
+  calculix.threads = settings.threads;
+  InterruptScope interrupts;
+  ProgressBar bar("ccx", false, settings.progress);
+  calculix.progress = [&](double fraction)
+  {
+    bar.Show(fraction);
+    return !Interrupted();
+  };
+  CompressionReport report;
+  try
+  {
+    report.result = mesh::solveCompression(m, settings.work, compression, calculix);
+  }
+  catch (const Cancelled&)
+  {
+    bar.End();
+    return std::nullopt;
+  }
+  bar.End();
+  const mesh::PointResults results = mesh::resultsOnMesh(m, mesh::readFrd(report.result.run.frd));
+  vtkNew<vtkUnstructuredGrid> grid;
+  ictk::vtk::solverResultsToVTK(m, results, report.result.compression.materials, grid);
+  WriteUnstructuredGrid(grid, file);
+  for (const double v : results.vonMises)
+  {
+    report.largestVonMises = std::max(report.largestVonMises, v);
+  }
+  return report;
+}
 
 std::unique_ptr<Command> solveCommand()
 {

@@ -275,4 +275,49 @@ TEST(Inv3, ClippedVoxelCell)
   EXPECT_THAT(parseError(R"({"box": [[0, 0, 0], [1, 1]]})"), HasSubstr("\"box\" must be"));
 }
 
+/// "combine" on a voxel cell: the scan's field united, intersected, subtracted or blended with
+/// an FRep as one field (FieldOperations.h), the clip still a separate inside field.
+TEST(Inv3, CombinedVoxelCell)
+{
+  TempDir dir;
+  const std::string path = dir.file("small.inv3");
+  writeGzip(path, project(mainPlist("int16", 3, 2, 2), smallMatrix()));
+  auto cellWith = [&](const std::string& combine)
+  {
+    const complex::Complex k = lang::readComplexJson(
+      R"({"cells": [{"name": "bone", "kind": "V", "dimension": 3, "file": ")" + path +
+        R"(", "iso": 0, "combine": )" + combine +
+        R"(, "clip": {"box": [[0, 0, 0], [1, 1, 1.5]]}}]})",
+      "combine.json");
+    return std::get<complex::ImplicitGeometry>(k.cell(k.cellsOfDimension(3)[0]).geometry);
+  };
+  const auto plain = cellWith("[]");
+  const auto united = cellWith(R"([{"op": "union", "inside": "x[2] - 0.5"}])");
+  const auto cut = cellWith(R"([{"op": "difference", "inside": "x[2] - 0.5", "alpha": 1}])");
+  const auto blended = cellWith(R"j([{"op": "blend", "inside": "x[2] - 0.5", "bound":
+    "0.3 - abs(x[1] - 0.5)", "a0": 0.5, "a1": 2, "a2": 2, "a3": 1}])j");
+  ASSERT_EQ(united.inside.size(), 2u); // the clip stays its own inside field
+  for (const frep::Point3& p : { frep::Point3{ 0.3, 0.7, 0.4 }, frep::Point3{ 0.6, 0.2, 1.1 },
+         frep::Point3{ 0.5, 0.5, 0.75 } })
+  {
+    const double f1 = value(plain.inside[0], p), f2 = p[1] - 0.5;
+    EXPECT_NEAR(value(united.inside[0], p), f1 + f2 + std::sqrt(f1 * f1 + f2 * f2), 1e-9);
+    EXPECT_NEAR(value(cut.inside[0], p), std::min(f1, -f2), 1e-9);
+    // Operations.h's bounded blend, written out: r = r1^2 / (r1^2 + r2^2) inside the bound.
+    const double f3 = 0.3 - std::abs(p[0] - 0.5);
+    const double r1 = (f1 / 2) * (f1 / 2) + (f2 / 2) * (f2 / 2);
+    const double r2 = f3 > 0 ? f3 * f3 : 0;
+    const double r = r2 > 0 ? r1 / (r1 + r2) : 1;
+    const double disp = r < 1 ? std::pow(1 - r * r, 3) / (1 + r * r) : 0;
+    EXPECT_NEAR(
+      value(blended.inside[0], p), f1 + f2 + std::sqrt(f1 * f1 + f2 * f2) + 0.5 * disp, 1e-9);
+  }
+  EXPECT_THAT(errorOf([&] { cellWith(R"([{"op": "xor", "inside": "1"}])"); }),
+    ::testing::AllOf(HasSubstr("combine[0]"), HasSubstr("\"union\"")));
+  EXPECT_THAT(errorOf([&] { cellWith(R"([{"op": "union", "inside": "1", "alpha": 2}])"); }),
+    HasSubstr("alpha"));
+  EXPECT_THAT(
+    errorOf([&] { cellWith(R"([{"op": "blend", "inside": "1"}])"); }), HasSubstr("\"bound\""));
+}
+
 } // namespace

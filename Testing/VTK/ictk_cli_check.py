@@ -904,9 +904,18 @@ def check_study(ictk, work, data):
         sys.exit(f"FAIL: {CRANIUM} is missing: install invesalius-examples (Scripts/setup does)")
     model = os.path.join(data, "Studies", "ct-implant", "ct-implant.json")
     vtu = os.path.join(work, "ct.vtu")
-    report = json.loads(run(ictk, ["study", model, "-o", vtu, "--deterministic", "--json"]).stdout)
+    # With CalculiX, the study also solves the compression case (--solve): E_app between the
+    # Reuss and Voigt bounds of its deck, the results beside the mesh.
+    solve = ["--solve", "0.06"] if shutil.which("ccx") else []
+    report = json.loads(run(ictk, ["study", model, "-o", vtu, "--deterministic", "--json"] + solve).stdout)
     if not os.path.exists(os.path.join(work, "ct.inp")):
         sys.exit("FAIL: no ct.inp beside ct.vtu")
+    if solve:
+        if not report["reuss_modulus"] <= report["apparent_modulus"] <= report["voigt_modulus"]:
+            sys.exit(f"FAIL: E_app {report['apparent_modulus']} outside [Reuss, Voigt] = "
+                     f"[{report['reuss_modulus']}, {report['voigt_modulus']}]")
+        if not os.path.exists(os.path.join(work, "ct-solved.vtu")):
+            sys.exit("FAIL: no ct-solved.vtu beside ct.vtu")
     no_leftovers(work)
     import vtk
     r = vtk.vtkXMLUnstructuredGridReader()
@@ -976,6 +985,56 @@ def check_study(ictk, work, data):
     # A 0.1 mm shell at size 1: CGAL would lose it (or never finish); refused before meshing.
     refused("thin", r"the implants' protected curves come 0\.0\d+ apart .* use --size 0\.3\d+ or less",
             shell_radius=2.6)
+    # The implant library's parameters are checked where the study file gives them: a screw of
+    # negative pitch is the complex file's diagnostic naming the function and the parameter.
+    folder = os.path.join(work, "pitch")
+    os.makedirs(folder)
+    implants = os.path.join(data, "Studies", "ct-implant", "implants.hf")
+    text = open(implants).read().replace("hfScrew(x, o, d, 1.5, 2.5, 3, 6)", "hfScrew(x, o, d, 1.5, 2.5, -3, 6)")
+    if "-3, 6)" not in text:
+        sys.exit("FAIL: implants.hf no longer has the screw this check edits")
+    open(os.path.join(folder, "implants.hf"), "w").write(text)
+    doc = json.load(open(os.path.join(data, "Studies", "ct-implant", "ct-implants.json")))
+    for cell in doc["cells"]:
+        if cell["kind"] == "V":
+            cell["file"] = CRANIUM
+    json.dump(doc, open(os.path.join(folder, "study.json"), "w"), indent=2)
+    p = run(ictk, ["study", os.path.join(folder, "study.json"), "-o", os.path.join(folder, "x.vtu")], check=False)
+    if p.returncode != 2 or "hfScrew: screw: pitch must be positive (got -3)" not in p.stderr:
+        sys.exit(f"FAIL: negative pitch: exit {p.returncode}, stderr:\n{p.stderr}")
+    if [f for f in os.listdir(folder) if f.startswith("x.")]:
+        sys.exit("FAIL: negative pitch: output written despite the error")
+
+
+def check_study_implants(ictk, work, data):
+    """ictk study on ct-implants.json (issue 15): the screw, the plate and the scaffold mesh into
+    their labels with the volumes of their formulas, and the study file's own "solve" runs
+    CalculiX: E_app between the deck's Reuss and Voigt bounds."""
+    if not os.path.exists(CRANIUM):
+        sys.exit(f"FAIL: {CRANIUM} is missing: install invesalius-examples (Scripts/setup does)")
+    if not shutil.which("ccx"):
+        sys.exit("FAIL: ccx is missing: install calculix-ccx (Scripts/setup does)")
+    model = os.path.join(data, "Studies", "ct-implant", "ct-implants.json")
+    report = json.loads(run(ictk, ["study", model, "-o", os.path.join(work, "imp.vtu"), "--deterministic",
+                                   "--threads", "2", "--json"]).stdout)
+    volumes = {m["name"]: m["volume"] for m in report["materials"]}
+    if sorted(volumes) != sorted(["soft", "bone", "screw", "screw_shell", "plate", "plate_shell", "scaffold",
+                                  "scaffold_shell"]):
+        sys.exit(f"FAIL: labels {sorted(volumes)}")
+    # The screw: pi E[r^2] L with r uniform in [1.5, 2.5] along the thread: 6 pi (2.25 + 1.5 + 1/3).
+    screw = 6 * math.pi * (2.25 + 1.5 + 1 / 3)
+    plate = 12 * 6 * 1.5 - 2 * math.pi * 1.25 ** 2 * 1.5
+    plate_shell = 13 * 7 * 2.5 - 2 * math.pi * 0.75 ** 2 * 2.5 - plate
+    for name, expected, tolerance in (("screw", screw, 0.02), ("plate", plate, 0.01),
+                                      ("plate_shell", plate_shell, 0.01)):
+        if abs(volumes[name] / expected - 1) > tolerance:
+            sys.exit(f"FAIL: {name} volume {volumes[name]} against {expected} (tolerance {tolerance})")
+    near(sum(volumes.values()), 24 * 24 * 6, 0.001 * 24 * 24 * 6, "total volume")
+    if not report["reuss_modulus"] <= report["apparent_modulus"] <= report["voigt_modulus"]:
+        sys.exit(f"FAIL: E_app {report['apparent_modulus']} outside [Reuss, Voigt] = "
+                 f"[{report['reuss_modulus']}, {report['voigt_modulus']}]")
+    if not os.path.exists(os.path.join(work, "imp-solved.vtu")):
+        sys.exit("FAIL: no imp-solved.vtu")
 
 
 def parse_arguments(usage):
@@ -1008,6 +1067,10 @@ def main():
     }
     if check == "study":
         check_study(ictk, work, rest[0])
+        print("OK")
+        return
+    if check == "study-implants":
+        check_study_implants(ictk, work, rest[0])
         print("OK")
         return
     if check == "tetra-bar":

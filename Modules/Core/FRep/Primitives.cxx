@@ -3,6 +3,7 @@
 // (repository pmur002/hyperfun, src/hflibrary_lib/hf*.c); where those are wrong or fragile the
 // comment says what differs and why. Every field is an Expr, so every evaluator supports it.
 #include "FRep/Primitives.h"
+#include "FRep/ParameterChecks.h"
 #include "FRep/Vector.h"
 
 #include <algorithm>
@@ -20,61 +21,14 @@ constexpr double pi = 3.14159265358979323846;
 
 // --- parameter checks: every message names the primitive and the parameter ----------------------
 
-[[noreturn]] void fail(const char* primitive, const std::string& what)
-{
-  throw std::invalid_argument(std::string(primitive) + ": " + what);
-}
-
-std::string show(double v)
-{
-  std::ostringstream out;
-  out.precision(12);
-  out << v;
-  return out.str();
-}
+using detail::fail;
+using detail::requireFinite;
+using detail::requirePositive;
+using detail::show;
 
 std::string indexed(const char* name, std::size_t i)
 {
   return std::string(name) + "[" + std::to_string(i) + "]";
-}
-
-void requireFinite(const char* primitive, const std::string& name, double v)
-{
-  if (!std::isfinite(v))
-  {
-    fail(primitive, name + " must be finite (got " + show(v) + ")");
-  }
-}
-
-void requireFinite(const char* primitive, const std::string& name, const Vec2& v)
-{
-  for (double c : v)
-  {
-    if (!std::isfinite(c))
-    {
-      fail(primitive, name + " must have finite coordinates (got " + show(c) + ")");
-    }
-  }
-}
-
-void requireFinite(const char* primitive, const std::string& name, const Vec3& v)
-{
-  for (double c : v)
-  {
-    if (!std::isfinite(c))
-    {
-      fail(primitive, name + " must have finite coordinates (got " + show(c) + ")");
-    }
-  }
-}
-
-void requirePositive(const char* primitive, const std::string& name, double v)
-{
-  requireFinite(primitive, name, v);
-  if (!(v > 0))
-  {
-    fail(primitive, name + " must be positive (got " + show(v) + ")");
-  }
 }
 
 void requireSameLength(

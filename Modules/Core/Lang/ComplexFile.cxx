@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
+// The complex file reader: one Reader class over the whole document (cells of every kind,
+// attributes, relations), its parts sharing the reader's diagnostics and HyperFun library, which
+// is why it runs past a thousand lines.
 #include "Lang/ComplexFile.h"
 
+#include "FRep/FieldOperations.h"
 #include "FRep/Tape.h"
 #include "Lang/HyperFun.h"
 #include "Voxel/VolumeFile.h"
@@ -612,15 +616,67 @@ private:
       g.bounds = clipped;
       // The scan's field first: the clip fields are the region's faces, and the CGAL backend
       // protects the curves where the iso-surface meets them (creases between inside fields).
-      g.inside.insert(g.inside.begin(), voxel::voxelField(grid, iso, side == "above"));
-      g.insideText.insert(
-        g.insideText.begin(), path + (side == "above" ? " >= " : " <= ") + std::to_string(iso));
+      FieldPtr scan = voxel::voxelField(grid, iso, side == "above");
+      std::string text = path + (side == "above" ? " >= " : " <= ") + std::to_string(iso);
+      if (spec.contains("combine") && !readCombine(spec["combine"], scan, text, where))
+      {
+        return;
+      }
+      g.inside.insert(g.inside.begin(), scan);
+      g.insideText.insert(g.insideText.begin(), text);
       c.geometry = std::move(g);
     }
     catch (const std::exception& e)
     {
       report(where + ": " + e.what(), current_);
     }
+  }
+
+  /// A voxel cell's "combine": [{"op": "union" | "intersection" | "difference" | "blend",
+  /// "inside": HyperFun, ...}, ...], applied in order to the scan's field (FieldOperations.h):
+  /// the R-functions with "alpha" (default 0), or the bounded blend with "bound" (HyperFun),
+  /// "a0" .. "a3" (default 1).
+  bool readCombine(const Json& list, FieldPtr& scan, std::string& text, const std::string& where)
+  {
+    if (!list.is_array())
+    {
+      report(where + ": \"combine\" must be a list of operations", current_);
+      return false;
+    }
+    for (std::size_t i = 0; i < list.size(); ++i)
+    {
+      const Json& o = list[i];
+      const std::string at = where + ": combine[" + std::to_string(i) + "]";
+      const std::string op = o.is_object() ? o.value("op", std::string()) : std::string();
+      if (!o.is_object() || !o.contains("inside") || !o["inside"].is_string() ||
+        (op != "union" && op != "intersection" && op != "difference" && op != "blend") ||
+        (op == "blend" && !(o.contains("bound") && o["bound"].is_string())))
+      {
+        report(at +
+            " must be {\"op\": \"union\", \"intersection\", \"difference\" or \"blend\", "
+            "\"inside\": HyperFun} (a blend also \"bound\": HyperFun)",
+          current_);
+        return false;
+      }
+      const std::string inside = o["inside"].get<std::string>();
+      const FieldPtr shape = field(compile(inside, 3, at));
+      const double alpha = number(o, "alpha", 0.0, at + ": \"alpha\"");
+      if (op == "blend")
+      {
+        const std::string bound = o["bound"].get<std::string>();
+        scan = frep::boundedBlendFields(scan, shape, field(compile(bound, 3, at)),
+          number(o, "a1", 1.0, at), number(o, "a2", 1.0, at), number(o, "a3", 1.0, at),
+          number(o, "a0", 1.0, at));
+      }
+      else
+      {
+        scan = op == "union"     ? frep::uniteFields(scan, shape, alpha)
+          : op == "intersection" ? frep::intersectFields(scan, shape, alpha)
+                                 : frep::subtractFields(scan, shape, alpha);
+      }
+      text = op + "(" + text + ", " + inside + ")";
+    }
+    return true;
   }
 
   /// A voxel cell's clip: {"box": [[lo], [hi]]} or {"inside": [HyperFun...], "bounds": [[lo],

@@ -11,6 +11,7 @@
 // a bug).
 #include "Lang/HyperFunCompilerDetail.h"
 
+#include "FRep/Implants.h"
 #include "FRep/Operations.h"
 #include "FRep/Primitives.h"
 
@@ -600,6 +601,67 @@ const std::unordered_map<std::string, Compiler::Handler>& Compiler::library()
       *slots[i] = number(f, n, 3 + i);
     count(40, n);
     return plain(kernel(n, [&] { return frep::spaceTimeBlendExpr(f1, f2, t, p); }));
+  };
+  // ICTK's implants (FRep/Implants.h, docs/medical.md), placed by an origin and an axis (3
+  // items each) in x's frame: hfPin(x, origin, axis, radius, length), hfScrew(x, origin, axis,
+  // core, major, pitch, length), hfPlate(x, origin, axis, reference, length, width, thickness,
+  // holeRadius, holes) with holes 2 items (x, y in the plate) per hole, and hfGyroid(x, cell,
+  // wall), whose wall may be any expression (a graded scaffold).
+  auto placement = [=](Frame& f, const ExprNode& n, bool withReference)
+  {
+    frep::Placement p;
+    p.origin = vec3(f, n, 1);
+    p.axis = vec3(f, n, 2);
+    if (withReference)
+    {
+      p.reference = vec3(f, n, 3);
+    }
+    return p;
+  };
+  L["hfpin"] = [=](Frame& f, const ExprNode& n)
+  {
+    args(n, 5);
+    const auto m = coordinates(f, n, 0);
+    const frep::Placement p = placement(f, n, false);
+    const double r = number(f, n, 3), length = number(f, n, 4);
+    return place(kernel(n, [&] { return frep::pin(r, length, p).function(); }), m, n);
+  };
+  L["hfscrew"] = [=](Frame& f, const ExprNode& n)
+  {
+    args(n, 7);
+    const auto m = coordinates(f, n, 0);
+    const frep::Placement p = placement(f, n, false);
+    const frep::ScrewThread t{ number(f, n, 3), number(f, n, 4), number(f, n, 5), number(f, n, 6) };
+    return place(kernel(n, [&] { return frep::screw(t, p).function(); }), m, n);
+  };
+  L["hfplate"] = [=](Frame& f, const ExprNode& n)
+  {
+    args(n, 9);
+    const auto m = coordinates(f, n, 0);
+    const frep::Placement p = placement(f, n, true);
+    frep::PlateShape s{ number(f, n, 4), number(f, n, 5), number(f, n, 6), number(f, n, 7), {} };
+    const auto holes = constants(f, n, 8);
+    if (holes.size() % 2 != 0)
+    {
+      const ExprNode& an = node(n.kids[8]);
+      fail(an.line, an.column,
+        "argument 9 of " + n.spelling + " must have 2 items (x, y) per hole, it has " +
+          std::to_string(holes.size()));
+    }
+    for (std::size_t i = 0; i + 1 < holes.size(); i += 2)
+    {
+      s.holes.push_back({ holes[i], holes[i + 1] });
+    }
+    return place(kernel(n, [&] { return frep::plate(s, p).function(); }), m, n);
+  };
+  L["hfgyroid"] = [=](Frame& f, const ExprNode& n)
+  {
+    args(n, 3);
+    const auto m = coordinates(f, n, 0);
+    const double cell = number(f, n, 1);
+    const Expr wall = eval(f, n.kids[2]).e;
+    const Val distance = place(kernel(n, [&] { return frep::gyroidDistance(cell); }), m, n);
+    return plain(0.5 * wall - distance.e);
   };
   L["hfshift3d"] = [=](Frame& f, const ExprNode& n)
   {

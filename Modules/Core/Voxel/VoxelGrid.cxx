@@ -174,4 +174,46 @@ VoxelGrid sampleToGrid(
   return grid;
 }
 
+std::int64_t stamp(VoxelGrid& grid, const frep::Field& region, double value)
+{
+  if (!std::isfinite(value))
+  {
+    throw std::invalid_argument("stamp: the stamped value must be finite");
+  }
+  const std::int64_t nx = grid.dimensions[0];
+  auto eval = region.evaluator();
+  std::vector<double> x(static_cast<std::size_t>(nx)), y(x.size()), z(x.size()), v(x.size());
+  for (std::int64_t i = 0; i < nx; ++i)
+  {
+    x[static_cast<std::size_t>(i)] = grid.point(i, 0, 0)[0];
+  }
+  std::int64_t stamped = 0;
+  for (std::int64_t k = 0; k < grid.dimensions[2]; ++k)
+  {
+    for (std::int64_t j = 0; j < grid.dimensions[1]; ++j)
+    {
+      const Point3 first = grid.point(0, j, k);
+      const Point3 last = grid.point(nx - 1, j, k);
+      const frep::Interval b = eval->bound(frep::Box3{ first, last });
+      if (b.negative() && !b.maybeNaN)
+      {
+        continue;
+      }
+      std::fill(y.begin(), y.end(), first[1]);
+      std::fill(z.begin(), z.end(), first[2]);
+      eval->values(x.data(), y.data(), z.data(), v.data(), x.size());
+      float* row = grid.values.data() + grid.index(0, j, k);
+      for (std::int64_t i = 0; i < nx; ++i)
+      {
+        if (v[static_cast<std::size_t>(i)] >= 0)
+        {
+          row[i] = static_cast<float>(value);
+          ++stamped;
+        }
+      }
+    }
+  }
+  return stamped;
+}
+
 } // namespace ictk::voxel

@@ -62,4 +62,11 @@ void validate(const VoxelGrid& grid, const std::string& what = "voxel grid");
 VoxelGrid sampleToGrid(
   const frep::Field& field, const frep::Box3& box, std::array<std::int64_t, 3> resolution);
 
+/// Stamps a solid into the grid (an implant into a scan, issue 15): every grid point where
+/// `region` >= 0 takes `value` (e.g. titanium's Hounsfield units), the others keep theirs, so
+/// the scan's materials and iso-surface see the implant. Returns how many points were stamped.
+/// Rows of points whose interval bound is negative are skipped unevaluated. Throws
+/// std::invalid_argument for a non-finite value.
+std::int64_t stamp(VoxelGrid& grid, const frep::Field& region, double value);
+
 } // namespace ictk::voxel
