@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML); .vm (Fidget's
-// SSA benchmark format, negated on import) is read only.
+// Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML); .scn and
+// .scene (seed 003's scenes, Lang/Scene.h) are read, and written only from a scene
+// (saveSceneFile); .vm (Fidget's SSA benchmark format, negated on import) is read only.
 
 #include "FRep/Hypervolume.h"
 #include "Lang/Diagnostics.h"
@@ -23,7 +24,7 @@ struct ModelFile
   std::optional<std::array<double, 6>> bounds;
 };
 
-/// True for paths ending in .hf, .xml or .vm (case-insensitive).
+/// True for paths ending in .hf, .xml, .scn, .scene or .vm (case-insensitive).
 bool isModelFile(const std::string& path);
 /// Opens a .hf or .xml file; throws ParseError (diagnostics name the file) or
 /// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model
@@ -38,5 +39,8 @@ std::array<double, 6> modelFileBounds(
   const ModelFile& file, const std::vector<double>& parameters = {});
 /// Saves as .hf or .xml by extension, through a temporary file renamed on success.
 void saveModelFile(const ModelFile& model, const std::string& path);
+/// Writes the scene file `input` as one self-contained scene file `path` (its `object`
+/// references inlined, seed 003 line 157), atomically as saveModelFile.
+void saveSceneFile(const std::string& input, const std::string& path, const Limits& limits = {});
 
 } // namespace ictk::lang
