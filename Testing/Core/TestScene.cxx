@@ -97,7 +97,7 @@ TEST(Scene, EveryKeyword)
   EXPECT_EQ(scene.objects[16].kind, lang::SceneNode::Kind::Intersection);
   EXPECT_EQ(lang::buildScene(scene).objects.size(), 19u);
   // `color` takes exactly three numbers.
-  EXPECT_EQ(firstError("ell { color 1 0 }"), "1:17: 'color' takes 3 numbers, found 2");
+  EXPECT_EQ(firstError("ell { color 1 0 }"), "1:7: 'color' takes 3 numbers, found 2");
   EXPECT_EQ(firstError("ell { color 1 0 0 1 }"),
     "1:19: 'color' takes 3 numbers (red, green, blue), found more");
   EXPECT_EQ(firstError("ell {\n  color 1 0 2\n}"), "2:3: a colour's components lie in [0, 1]");
@@ -293,7 +293,7 @@ TEST(Scene, Diagnostics)
     "2:1: unknown object 'sphere' (expected a quadric type, "
     "torus, cube, union, intersection, inter or object)");
   EXPECT_EQ(firstError("ell {\n  scale 1 0 1\n}"), "2:3: a scale factor must not be 0");
-  EXPECT_EQ(firstError("ell { move 1 2 }"), "1:16: 'move' takes 3 numbers, found 2");
+  EXPECT_EQ(firstError("ell { move 1 2 }"), "1:7: 'move' takes 3 numbers, found 2");
   EXPECT_EQ(firstError("ell {"), "1:5: '{' is not closed");
   EXPECT_EQ(firstError("ell }"), "1:5: '}' without a matching '{'");
   EXPECT_EQ(firstError("ell { cone }"),

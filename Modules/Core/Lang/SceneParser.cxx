@@ -302,7 +302,7 @@ private:
     {
       if (token_.kind != TokenKind::Number)
       {
-        error(token_.kind == TokenKind::End ? keyword : token_,
+        error(keyword,
           "'" + keyword.text + "' takes " + std::to_string(n) + " number" + (n == 1 ? "" : "s") +
             (i == 0 ? std::string() : ", found " + std::to_string(i)));
         return false;
