@@ -63,12 +63,7 @@ public:
       }
       catch (const lang::ParseError& e)
       {
-        std::string text = e.what();
-        while (!text.empty() && text.back() == '\n')
-        {
-          text.pop_back();
-        }
-        throw ModelFileError(text);
+        throw AsModelFileError(e);
       }
       catch (const std::exception& e)
       {

@@ -289,24 +289,31 @@ TEST(Scene, ObjectReferenceAndSelfContainedSave)
 
 TEST(Scene, Diagnostics)
 {
-  EXPECT_EQ(firstError("ell\nsphere"),
-    "2:1: unknown object 'sphere' (expected a quadric type, "
-    "torus, cube, union, intersection, inter or object)");
-  EXPECT_EQ(firstError("ell {\n  scale 1 0 1\n}"), "2:3: a scale factor must not be 0");
-  EXPECT_EQ(firstError("ell { move 1 2 }"), "1:7: 'move' takes 3 numbers, found 2");
-  EXPECT_EQ(firstError("ell {"), "1:5: '{' is not closed");
-  EXPECT_EQ(firstError("ell }"), "1:5: '}' without a matching '{'");
-  EXPECT_EQ(firstError("ell { cone }"),
-    "1:7: 'cone' is not an item of a primitive's block (objects go in a union or intersection "
-    "block)");
-  EXPECT_EQ(firstError("union { }"), "1:1: 'union' holds no object");
-  EXPECT_EQ(firstError("// nothing\n"), "2:1: the scene has no object");
-  EXPECT_EQ(firstError("ell { move 1e999 0 0 }"), "1:12: '1e999' is not a finite number");
-  EXPECT_EQ(firstError("ell { radii 1 2 }"), "1:7: 'radii' applies to a torus");
-  EXPECT_EQ(firstError("ell { matrix 1 0 0 0 0 0 0 0 0 0 1 0 }"),
-    "1:7: the transformations are singular (they flatten the object): no inverse to place it by");
-  EXPECT_EQ(firstError("object x"), "1:8: 'object x': references to files are not read here");
-  EXPECT_EQ(firstError("ell /* open"), "1:5: unterminated comment");
+  const std::pair<const char*, const char*> cases[] = {
+    { "ell\nsphere",
+      "2:1: unknown object 'sphere' (expected a quadric type, torus, cube, union, intersection, "
+      "inter or object)" },
+    { "ell {\n  scale 1 0 1\n}", "2:3: a scale factor must not be 0" },
+    { "ell { move 1 2 }", "1:7: 'move' takes 3 numbers, found 2" },
+    { "ell {", "1:5: '{' is not closed" },
+    { "ell }", "1:5: '}' without a matching '{'" },
+    { "ell { cone }",
+      "1:7: 'cone' is not an item of a primitive's block (objects go in a union or intersection "
+      "block)" },
+    { "union { }", "1:1: 'union' holds no object" },
+    { "// nothing\n", "2:1: the scene has no object" },
+    { "ell { move 1e999 0 0 }", "1:12: '1e999' is not a finite number" },
+    { "ell { radii 1 2 }", "1:7: 'radii' applies to a torus" },
+    { "ell { matrix 1 0 0 0 0 0 0 0 0 0 1 0 }",
+      "1:7: the transformations are singular (they flatten the object): no inverse to place it "
+      "by" },
+    { "object x", "1:8: 'object x': references to files are not read here" },
+    { "ell /* open", "1:5: unterminated comment" },
+  };
+  for (const auto& [text, expected] : cases)
+  {
+    EXPECT_EQ(firstError(text), expected);
+  }
   // Several errors in one run, each with its place and its source line.
   try
   {
