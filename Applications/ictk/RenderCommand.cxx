@@ -633,6 +633,13 @@ private:
     {
       std::cout << ", object " << p.values[0];
     }
+    if (model.Model.findAttribute("perturbation"))
+    {
+      // Seed 003's Ctrl-click: the perturbation under the cursor (0: none).
+      const render::Pick q =
+        render::pick(model.Model, { model.Lo, model.Hi }, camera, i, j, "perturbation", options);
+      std::cout << ", perturbation " << (q.values.empty() ? 0.0 : q.values[0]);
+    }
     std::cout << "\n";
   }
 

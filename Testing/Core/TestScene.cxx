@@ -362,6 +362,40 @@ TEST(Scene, PickTheFrontmostObject)
   EXPECT_THROW(render::pick(s.model, box, camera, 1, 1, "density"), std::invalid_argument);
 }
 
+TEST(Scene, PickAPerturbation)
+{
+  // Item 38 with seed 003's Ctrl flag: the attribute "perturbation" is the id of the perturbation
+  // whose support holds the point, 0 where none does. Two perturbations of one ball (ids 1 and 2)
+  // and a second ball without any.
+  const lang::BuiltScene s = build("ell { perturb 0.15625 ell { scale 0.5 move 1 0 0 }\n"
+                                   "      perturb 1 ell { scale 0.3 move 0 1 0 } }\n"
+                                   "ell { move 3 0 0 }");
+  ASSERT_EQ(s.perturbations.size(), 2u);
+  EXPECT_EQ(s.perturbations[1].where.line, 2);
+  const frep::Attribute* a = s.model.findAttribute("perturbation");
+  ASSERT_NE(a, nullptr);
+  auto perturbationAt = [&](double x, double y, double z)
+  {
+    return attributes(s.model, x, y, z).back();
+  };
+  EXPECT_EQ(perturbationAt(1.05, 0, 0), 1);
+  EXPECT_EQ(perturbationAt(0, 1.0, 0), 2);
+  EXPECT_EQ(perturbationAt(-1, 0, 0), 0);
+  EXPECT_EQ(perturbationAt(3, 0, 0), 0);
+  // Picked from -x the ball's unperturbed side shows (0); from above, on the ray x = 1, y = 0,
+  // the bump of perturbation 1.
+  const frep::Box3 box{ { -1.5, -1.5, -1.5 }, { 4.5, 1.5, 1.5 } };
+  const render::Camera camera = render::Camera::lookAt(
+    { -10, 0, 0 }, { 0, 0, 0 }, { 0, 0, 1 }, render::Projection::Orthographic, 30, 2, 21, 21);
+  const render::Pick front = render::pick(s.model, box, camera, 10, 10, "perturbation");
+  ASSERT_TRUE(front.hit);
+  EXPECT_EQ(front.values[0], 0);
+  const render::Camera east = render::Camera::lookAt(
+    { 1, 0, 10 }, { 1, 0, 0 }, { 0, 1, 0 }, render::Projection::Orthographic, 30, 2, 21, 21);
+  EXPECT_EQ(render::pick(s.model, box, east, 10, 10, "perturbation").values[0], 1);
+  EXPECT_EQ(render::pick(s.model, box, east, 10, 10, "object").values[0], 1);
+}
+
 TEST(Scene, ReRenderingAfterAnEditMakesNoMesh)
 {
   // Item 36: changing a perturbation factor and rendering again gives a new depth buffer straight

@@ -121,8 +121,13 @@ struct BuiltScene
   /// with the attribute "object" (the id of the primitive whose field decides f at the point)
   /// and, when some object has a `color`, the attribute "colour" (that primitive's colour, an
   /// object without one taking its nearest enclosing block's, else 0.8 grey).
+  /// When some object is perturbed, also the attribute "perturbation": the id of the
+  /// perturbation (numbered from 1 in the file's order, like the objects) whose support (Q >= 0)
+  /// holds the point, on the primitive that decides f (the last written where supports overlap),
+  /// 0 where none does: picking it is seed 003's Ctrl-click, which selects perturbations only.
   frep::Hypervolume model;
   std::vector<SceneObject> objects;
+  std::vector<SceneObject> perturbations;
 };
 /// Throws ParseError (at the node) for what reads but does not build: a singular matrix, an
 /// empty union or intersection, a scale of 0.

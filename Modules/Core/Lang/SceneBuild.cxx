@@ -104,6 +104,9 @@ struct Part
   frep::Expr f;
   frep::Expr id;
   std::array<frep::Expr, 3> rgb;
+  /// The id of the perturbation whose support holds the point (the last written where supports
+  /// overlap), 0 where none does.
+  frep::Expr perturbation;
 };
 
 class Builder
@@ -142,6 +145,7 @@ public:
   }
 
   std::vector<SceneObject> objects;
+  std::vector<SceneObject> perturbations;
 
 private:
   [[noreturn]] static void fail(const SourceLocation& where, const std::string& message)
@@ -170,6 +174,7 @@ private:
         shape = frep::namedQuadric(n.quadric);
         break;
     }
+    frep::Expr perturbation(0.0);
     if (!n.perturbations.empty())
     {
       std::vector<frep::Shape> quadrics;
@@ -179,6 +184,12 @@ private:
         frep::Shape q = frep::namedQuadric(p.quadric.quadric);
         quadrics.push_back(frep::Shape(transformed(q.function(), p.quadric), frep::Domain::XYZ));
         factors.push_back(p.factor);
+        const int pid = static_cast<int>(perturbations.size()) + 1;
+        perturbations.push_back(
+          { pid, frep::quadricTypeInfo(p.quadric.quadric).keyword, p.quadric.where });
+        // Q >= 0: inside the support of R = k max(0, Q)^3.
+        perturbation = frep::select(
+          quadrics.back().function(), frep::Expr(static_cast<double>(pid)), perturbation);
       }
       shape = frep::perturb(shape, quadrics, factors);
     }
@@ -187,6 +198,7 @@ private:
     Part part;
     part.f = shape.function();
     part.id = frep::Expr(static_cast<double>(id));
+    part.perturbation = perturbation;
     for (std::size_t c = 0; c < 3; ++c)
     {
       part.rgb[c] = frep::Expr(coloured_ ? colour[c] : 0.0);
@@ -214,6 +226,7 @@ private:
     Part part;
     part.f = minimum ? frep::min(a.f, b.f) : frep::max(a.f, b.f);
     part.id = frep::select(aWins, a.id, b.id);
+    part.perturbation = frep::select(aWins, a.perturbation, b.perturbation);
     for (std::size_t c = 0; c < 3; ++c)
     {
       part.rgb[c] = frep::select(aWins, a.rgb[c], b.rgb[c]);
@@ -256,6 +269,7 @@ private:
     Part out;
     out.f = transformed(p.f, n);
     out.id = transformed(p.id, n);
+    out.perturbation = transformed(p.perturbation, n);
     for (std::size_t c = 0; c < 3; ++c)
     {
       out.rgb[c] = transformed(p.rgb[c], n);
@@ -306,7 +320,15 @@ BuiltScene buildScene(const Scene& scene)
     colour.components = { part.rgb[0], part.rgb[1], part.rgb[2] };
     built.model.addAttribute(std::move(colour));
   }
+  if (!builder.perturbations.empty())
+  {
+    frep::Attribute perturbation;
+    perturbation.name = "perturbation";
+    perturbation.components = { part.perturbation };
+    built.model.addAttribute(std::move(perturbation));
+  }
   built.objects = std::move(builder.objects);
+  built.perturbations = std::move(builder.perturbations);
   return built;
 }
 
