@@ -26,9 +26,10 @@ struct ModelFile
 
 /// True for paths ending in .hf, .xml, .scn, .scene or .vm (case-insensitive).
 bool isModelFile(const std::string& path);
-/// Opens a .hf or .xml file; throws ParseError (diagnostics name the file) or
+/// Opens a .hf, .xml, .scn or .vm file; throws ParseError (diagnostics name the file) or
 /// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model
-/// (see readHyperFun); an XML model keeps its parameter slots.
+/// (see readHyperFun); an XML model keeps its parameter slots. A scene is its built hypervolume
+/// (lang::buildScene: the attributes "object", "colour", "perturbation").
 ModelFile loadModelFile(const std::string& path, const Limits& limits = {},
   const std::vector<double>& parameterValues = {});
 /// A box {xmin, xmax, ymin, ymax, zmin, zmax} that holds the model: the file's own bounds when it

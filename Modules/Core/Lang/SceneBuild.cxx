@@ -150,7 +150,10 @@ public:
 private:
   [[noreturn]] static void fail(const SourceLocation& where, const std::string& message)
   {
-    throw ParseError({ Diagnostic{ where, message, {} } });
+    Diagnostic d;
+    d.where = where;
+    d.message = message;
+    throw ParseError({ d });
   }
 
   /// The field of a primitive in its own frame, perturbed.
@@ -298,7 +301,10 @@ BuiltScene buildScene(const Scene& scene)
 {
   if (scene.objects.empty())
   {
-    throw ParseError({ Diagnostic{ { scene.file, 0, 0 }, "the scene has no object", {} } });
+    Diagnostic d;
+    d.where.file = scene.file;
+    d.message = "the scene has no object";
+    throw ParseError({ d });
   }
   const bool coloured = hasColour(scene.objects);
   Builder builder(coloured);
@@ -308,7 +314,7 @@ BuiltScene buildScene(const Scene& scene)
   top.children = scene.objects;
   const std::array<double, 3> grey{ DefaultGrey, DefaultGrey, DefaultGrey };
   const Part part = builder.node(top, grey);
-  BuiltScene built{ frep::Hypervolume(frep::Shape(part.f, frep::Domain::XYZ, "scene")), {} };
+  BuiltScene built{ frep::Hypervolume(frep::Shape(part.f, frep::Domain::XYZ, "scene")), {}, {} };
   frep::Attribute id;
   id.name = "object";
   id.components = { part.id };
