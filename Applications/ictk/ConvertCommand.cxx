@@ -4,8 +4,6 @@
 #include "Command.h"
 #include "Models.h"
 
-#include "Lang/Scene.h"
-
 #include <CLI/CLI.hpp>
 
 #include <iostream>

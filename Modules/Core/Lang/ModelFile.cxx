@@ -175,6 +175,11 @@ bool isModelFile(const std::string& path)
   return formatOf(path) != Format::Unknown;
 }
 
+bool isSceneFile(const std::string& path)
+{
+  return formatOf(path) == Format::Scene;
+}
+
 ModelFile loadModelFile(
   const std::string& path, const Limits& limits, const std::vector<double>& parameterValues)
 {

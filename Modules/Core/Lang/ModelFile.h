@@ -26,6 +26,8 @@ struct ModelFile
 
 /// True for paths ending in .hf, .xml, .scn, .scene or .vm (case-insensitive).
 bool isModelFile(const std::string& path);
+/// True for paths ending in .scn or .scene (case-insensitive): seed 003's scenes (Lang/Scene.h).
+bool isSceneFile(const std::string& path);
 /// Opens a .hf, .xml, .scn or .vm file; throws ParseError (diagnostics name the file) or
 /// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model
 /// (see readHyperFun); an XML model keeps its parameter slots. A scene is its built hypervolume

@@ -96,8 +96,6 @@ struct Scene
 using SceneLoader = std::function<std::optional<std::pair<std::string, std::string>>(
   const std::string& name, const std::string& from)>;
 
-/// True for paths ending in .scn or .scene (case-insensitive).
-bool isSceneFile(const std::string& path);
 /// Parses scene text; `file` names it in diagnostics. `loader` reads `object` references (none:
 /// every reference is an error). Throws ParseError with every error found (file:line:col).
 Scene parseScene(const std::string& text, const std::string& file, const SceneLoader& loader,

@@ -10,14 +10,22 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <set>
 #include <system_error>
+#include <utility>
 
 namespace ictk::lang
 {
 
 namespace
 {
+
+/// The transformations' keywords, for the parser and the writer.
+constexpr std::pair<const char*, SceneTransform::Kind> TransformKeywords[] = {
+  { "move", SceneTransform::Kind::Move }, { "rotate", SceneTransform::Kind::Rotate },
+  { "scale", SceneTransform::Kind::Scale }, { "skewx", SceneTransform::Kind::SkewX },
+  { "skewy", SceneTransform::Kind::SkewY }, { "skewz", SceneTransform::Kind::SkewZ },
+  { "matrix", SceneTransform::Kind::Matrix }
+};
 
 enum class TokenKind
 {
@@ -530,12 +538,6 @@ private:
   /// The items every object takes: inverse, transformations, color. False: not one of them.
   bool item(SceneNode& node, const Token& item)
   {
-    static const std::pair<const char*, SceneTransform::Kind> transforms[] = {
-      { "move", SceneTransform::Kind::Move }, { "rotate", SceneTransform::Kind::Rotate },
-      { "scale", SceneTransform::Kind::Scale }, { "skewx", SceneTransform::Kind::SkewX },
-      { "skewy", SceneTransform::Kind::SkewY }, { "skewz", SceneTransform::Kind::SkewZ },
-      { "matrix", SceneTransform::Kind::Matrix }
-    };
     if (item.text == "inverse")
     {
       advance();
@@ -573,7 +575,7 @@ private:
       }
       return true;
     }
-    for (const auto& [word, kind] : transforms)
+    for (const auto& [word, kind] : TransformKeywords)
     {
       if (item.text != word)
       {
@@ -685,22 +687,12 @@ std::string number(double v)
 
 const char* transformKeyword(SceneTransform::Kind kind)
 {
-  switch (kind)
+  for (const auto& [word, k] : TransformKeywords)
   {
-    case SceneTransform::Kind::Move:
-      return "move";
-    case SceneTransform::Kind::Rotate:
-      return "rotate";
-    case SceneTransform::Kind::Scale:
-      return "scale";
-    case SceneTransform::Kind::SkewX:
-      return "skewx";
-    case SceneTransform::Kind::SkewY:
-      return "skewy";
-    case SceneTransform::Kind::SkewZ:
-      return "skewz";
-    case SceneTransform::Kind::Matrix:
-      return "matrix";
+    if (k == kind)
+    {
+      return word;
+    }
   }
   return "move";
 }
@@ -786,23 +778,7 @@ void write(const SceneNode& node, int indent, std::string& out)
   out += pad + "}\n";
 }
 
-std::string lowerExtension(const std::string& path)
-{
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext)
-  {
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
-  return ext;
-}
-
 } // namespace
-
-bool isSceneFile(const std::string& path)
-{
-  const std::string ext = lowerExtension(path);
-  return ext == ".scn" || ext == ".scene";
-}
 
 Scene parseScene(
   const std::string& text, const std::string& file, const SceneLoader& loader, const Limits& limits)
