@@ -28,6 +28,17 @@ const frep::ModelInfo& FindModel(const std::string& name)
   }
 }
 
+ModelFileError AsModelFileError(const lang::ParseError& e)
+{
+  // Every diagnostic, each "file:line:col: error: ..." with its source line and caret.
+  std::string text = e.what();
+  while (!text.empty() && text.back() == '\n')
+  {
+    text.pop_back();
+  }
+  return ModelFileError(text);
+}
+
 lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>& params)
 {
   try
@@ -36,13 +47,7 @@ lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>
   }
   catch (const lang::ParseError& e)
   {
-    // Every diagnostic, each "file:line:col: error: ..." with its source line and caret.
-    std::string text = e.what();
-    while (!text.empty() && text.back() == '\n')
-    {
-      text.pop_back();
-    }
-    throw ModelFileError(text);
+    throw AsModelFileError(e);
   }
   catch (const std::invalid_argument& e)
   {

@@ -4,6 +4,8 @@
 // models`), a model file (.hf, .xml) or a complex (.json). Failures are UserErrors; a model file's
 // diagnostics are a ModelFileError (printed as they are: file:line:col, source line, caret).
 
+#include "Command.h"
+
 #include "Complex/Complex.h"
 #include "Engine/DynamicModel.h"
 #include "FRep/Hypervolume.h"
@@ -20,6 +22,9 @@ namespace ictk::cli
 
 /// A registered model, by name.
 const frep::ModelInfo& FindModel(const std::string& name);
+
+/// A front end's diagnostics as the error `ictk` prints as they are.
+ModelFileError AsModelFileError(const lang::ParseError& e);
 
 /// Opens a model file (.hf, .xml), specialised to `params` (a HyperFun file's library may need
 /// them where it wants numbers).

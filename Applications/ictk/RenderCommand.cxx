@@ -146,6 +146,10 @@ public:
       "raycast (default: solids ray cast exactly, meshed cells rasterised exactly) or mesh "
       "(every cell's discretisation through VTK's OpenGL pipeline offscreen; complexes only, "
       "needs an X display or xvfb-run)");
+    render->add_option("--pick", this->PickAt,
+      "X,Y: also print what the picture shows at pixel column X (from the left) and row Y (from "
+      "the top): the surface point, its depth and, for a scene (.scn), the id of the frontmost "
+      "object (FRep models)");
     render->add_option("--depth", this->Depth,
       "Also write the depth buffer (distance along each pixel's ray, inf where nothing is hit) "
       "as .vti");
@@ -572,6 +576,10 @@ private:
           return !Interrupted();
         });
       bar.End();
+      if (!this->PickAt.empty())
+      {
+        this->PrintPick(model, camera);
+      }
     }
     const double seconds = Seconds(t0);
     WritePng(drawn.Buffers(), picture, this->Output);
@@ -584,6 +592,55 @@ private:
               << std::fixed << std::setprecision(3) << seconds << " s\n";
     Warn(drawn, name);
     return 0;
+  }
+
+  /// --pick: what the picture shows at one pixel (seed 003 item 38: the frontmost object's id).
+  void PrintPick(const ResolvedModel& model, const render::Camera& camera) const
+  {
+    const std::vector<std::int64_t> xy = ParseIntegers(this->PickAt, "--pick", { "X", "Y" }, "X,Y");
+    if (xy[0] < 0 || xy[0] >= this->Width || xy[1] < 0 || xy[1] >= this->Height)
+    {
+      throw UserError("--pick: " + this->PickAt + " is outside the " + std::to_string(this->Width) +
+        " x " + std::to_string(this->Height) + " picture");
+    }
+    const bool scene = model.Model.findAttribute("object") != nullptr;
+    render::RayCastOptions options;
+    options.parameters = ParseParameters(this->Params);
+    options.time = this->Time;
+    options.threads = this->Threads;
+    // Rows of the PNG count from the top; the core's from the bottom.
+    const int i = static_cast<int>(xy[0]);
+    const int j = this->Height - 1 - static_cast<int>(xy[1]);
+    render::Pick p;
+    try
+    {
+      p = render::pick(model.Model, { model.Lo, model.Hi }, camera, i, j,
+        scene ? "object" : std::string(), options);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      throw UserError(std::string("--pick: ") + e.what());
+    }
+    std::cout << "pick " << xy[0] << "," << xy[1] << ": ";
+    if (!p.hit)
+    {
+      std::cout << "nothing (background)\n";
+      return;
+    }
+    std::cout << std::setprecision(9) << "point " << p.point[0] << "," << p.point[1] << ","
+              << p.point[2] << ", depth " << p.depth;
+    if (scene && !p.values.empty())
+    {
+      std::cout << ", object " << p.values[0];
+    }
+    if (model.Model.findAttribute("perturbation"))
+    {
+      // Seed 003's Ctrl-click: the perturbation under the cursor (0: none).
+      const render::Pick q =
+        render::pick(model.Model, { model.Lo, model.Hi }, camera, i, j, "perturbation", options);
+      std::cout << ", perturbation " << (q.values.empty() ? 0.0 : q.values[0]);
+    }
+    std::cout << "\n";
   }
 
   int RunFrames(bool dynamic)
@@ -765,6 +822,7 @@ private:
   };
   std::optional<CameraSpec> LookAt;
   std::string Depth;
+  std::string PickAt;
   // Checked values.
   int Width = 0;
   int Height = 0;

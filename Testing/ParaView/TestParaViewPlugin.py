@@ -79,7 +79,8 @@ def readers_for(path):
     return [found.GetString(i) for i in range(1, found.GetLength(), 3)]
 
 
-for ext, reader in [("hf", "ictkFRepReader"), ("vm", "ictkFRepReader"), ("icm", "ictkDynamicComplexReader")]:
+for ext, reader in [("hf", "ictkFRepReader"), ("vm", "ictkFRepReader"), ("scn", "ictkFRepReader"),
+                    ("icm", "ictkDynamicComplexReader")]:
     path = os.path.join(WORK, "probe." + ext)
     open(path, "w").close()
     ok = factory.CanReadFile(path, session)

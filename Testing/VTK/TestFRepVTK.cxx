@@ -4,9 +4,11 @@
 #include "FRep/Domain.h"
 #include "FRep/Expr.h"
 #include "FRep/Hypervolume.h"
+#include "FRep/Primitives.h"
 
 #include "ictkFRepImplicitFunction.h"
 #include "ictkFRepSampler.h"
+#include "ictkQuadricToVtk.h"
 
 #include <vtkCallbackCommand.h>
 #include <vtkClipPolyData.h>
@@ -18,6 +20,7 @@
 #include <vtkNew.h>
 #include <vtkPlaneSource.h>
 #include <vtkPointData.h>
+#include <vtkQuadric.h>
 #include <vtkSMPTools.h>
 #include <vtkTriangleFilter.h>
 
@@ -26,6 +29,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -429,4 +433,21 @@ TEST(FRepImplicitFunction, ClipsAPlaneToTheUnitDisk)
   mass->SetInputConnection(triangles->GetOutputPort());
   mass->Update();
   EXPECT_NEAR(mass->GetSurfaceArea(), M_PI, 0.01 * M_PI);
+}
+
+TEST(QuadricToVtk, ValuesAreMinusFAtRandomPoints)
+{
+  // papers.md 5.B item 25: a0..a9 = (A11, A22, A33, A12, A23, A13, A14, A24, A34, A44) negated;
+  // vtkQuadric's value is -F at 100 random points.
+  const std::array<double, 10> k{ 1.5, -2, 0.5, 0.3, -0.7, 1.1, 3, -4, 0.25, 0.2 };
+  const ictk::frep::Expr f = ictk::frep::quadric(k).function();
+  const vtkSmartPointer<vtkQuadric> vtk = ictkQuadricToVtk(k);
+  std::mt19937_64 rng(25);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (int i = 0; i < 100; ++i)
+  {
+    double p[3] = { u(rng), u(rng), u(rng) };
+    const double value = ictk::frep::evaluateReference(f, { p[0], p[1], p[2], 0 });
+    EXPECT_NEAR(vtk->EvaluateFunction(p), -value, 1e-12 * (1 + std::abs(value)));
+  }
 }

@@ -565,18 +565,47 @@ Shape quadric(const std::array<double, 10>& k)
   {
     fail("quadric", "all ten coefficients are zero (the field would vanish everywhere)");
   }
-  const Expr x = Expr::x();
-  const Expr y = Expr::y();
-  const Expr z = Expr::z();
-  const Expr monomials[] = { square(x), square(y), square(z), x * y, x * z, y * z, x, y, z,
-    Expr(1.0) };
+  // Completed squares: a squared term with its axis' linear term becomes A (x + b / 2A)^2 and the
+  // constant takes -b^2 / 4A. Interval arithmetic then gives the exact range of each such term
+  // over an interval (x^2 + b x as two terms would not: x appears twice), so the range of an
+  // axis-aligned quadric over a box is exact (papers.md 5.B item 31's max_B F).
+  const Expr axes[] = { Expr::x(), Expr::y(), Expr::z() };
   std::vector<Expr> terms;
-  for (std::size_t i = 0; i < k.size(); ++i)
+  double constant = k[9];
+  for (std::size_t i = 0; i < 3; ++i)
   {
-    if (k[i] != 0)
+    const double a = k[i];
+    const double b = k[6 + i];
+    const double shift = a != 0 ? b / (2 * a) : 0.0;
+    if (a != 0 && std::isfinite(a * shift * shift))
     {
-      terms.push_back(k[i] * monomials[i]);
+      terms.push_back(a * square(axes[i] + shift));
+      constant -= a * shift * shift;
     }
+    else
+    {
+      // No square, or one so flat that completing it overflows: the monomials as they are.
+      if (a != 0)
+      {
+        terms.push_back(a * square(axes[i]));
+      }
+      if (b != 0)
+      {
+        terms.push_back(b * axes[i]);
+      }
+    }
+  }
+  const Expr crossTerms[] = { axes[0] * axes[1], axes[0] * axes[2], axes[1] * axes[2] };
+  for (std::size_t i = 0; i < 3; ++i)
+  {
+    if (k[3 + i] != 0)
+    {
+      terms.push_back(k[3 + i] * crossTerms[i]);
+    }
+  }
+  if (constant != 0)
+  {
+    terms.push_back(Expr(constant));
   }
   return Shape(balancedSum(std::move(terms)), Domain::XYZ, "quadric");
 }
@@ -850,8 +879,18 @@ Expr gardnerNoise(double amplitude, double frequency, double phase)
   return serX * serY * serZ;
 }
 
-// seed 003 eq. (2)-(3) with papers.md E9's signed factor: F + sum k_i max(0, Q_i)^3. The cube of
-// max(0, Q) is Q^3 where Q >= 0 and 0 elsewhere, and is C^2 across Q = 0.
+// seed 003 eq. (3) with papers.md E9's signed factor. The cube of max(0, Q) is Q^3 where Q >= 0
+// and 0 elsewhere, and is C^2 across Q = 0. Under interval arithmetic max(0, Q) is
+// [max(0, lo), max(0, hi)] and the cube is monotone there, so the bound of a perturbed field over a
+// box is max_B F + sum over k > 0 of k max(0, max_B Q)^3 + sum over k < 0 of k max(0, min_B Q)^3:
+// papers.md 2.2's voxel bound (item 31), which the renderer's culling therefore uses.
+Expr perturbation(const Expr& perturbingQuadric, double factor)
+{
+  requireFinite("perturbation", "factor", factor);
+  return factor * pow(max(0.0, perturbingQuadric), 3.0);
+}
+
+// seed 003 eq. (2): F + sum R_i.
 Shape perturb(const Shape& base, const std::vector<Shape>& perturbingQuadrics,
   const std::vector<double>& factors)
 {
@@ -866,7 +905,7 @@ Shape perturb(const Shape& base, const std::vector<Shape>& perturbingQuadrics,
   {
     requireSameDomain("perturb", base, perturbingQuadrics[i]);
     requireFinite("perturb", indexed("factors", i), factors[i]);
-    terms.push_back(factors[i] * pow(max(0.0, perturbingQuadrics[i].function()), 3.0));
+    terms.push_back(perturbation(perturbingQuadrics[i].function(), factors[i]));
   }
   // Where every Q_i < 0 each term is (+-)0, so F' == F bit for bit (papers.md 5.B item 27).
   return Shape(base.function() + balancedSum(std::move(terms)), base.domain(), "perturb");

@@ -66,7 +66,10 @@ Shape torus(Axis axis, const Vec3& center, double R, double r);
 Shape superellipsoid(const Vec3& center, double a, double b, double c, double s1, double s2);
 /// General quadric with 10 coefficients (seed 003 eq. 1), no factor 2 on the cross terms:
 /// A11x^2 + A22y^2 + A33z^2 + A12xy + A13xz + A23yz + A14x + A24y + A34z + A44,
-/// coefficients in that order. All ten zero is rejected (f would vanish everywhere).
+/// coefficients in that order. All ten zero is rejected (f would vanish everywhere). Lowered with
+/// each axis' square completed (A11 (x + A14 / 2A11)^2 ...), so that interval arithmetic gives the
+/// exact range of an axis-aligned quadric over a box. The named types of seed 003 are in
+/// FRep/Quadrics.h.
 Shape quadric(const std::array<double, 10>& coefficients);
 /// Half-space bounded by the plane through `point` with normal `inwardNormal` (pointing into the
 /// solid): f = n.(p - point) / |n|, the signed distance to the plane (>= 0 on the normal's side).
@@ -134,6 +137,10 @@ Expr cauchyTriangleField(const std::array<Vec3, 3>& triangle, double s);
 /// Ser(x) Ser(y) Ser(z), Ser(x) = A sin(w x) + (A/1.17) sin(w x/1.35 + phase sin(w z)), and
 /// cyclically (y uses sin(w x), z uses sin(w y)); A = amplitude, w = frequency.
 Expr gardnerNoise(double amplitude, double frequency, double phase);
+/// One perturbation function (seed 003 eq. 3 with the factor of papers.md E9):
+/// R = k Q^3 where Q >= 0, else 0 (k max(0, Q)^3). C^2 across Q = 0; its interval bound over a box
+/// is k max(0, max_B Q)^3 from above for k > 0 and k max(0, min_B Q)^3 for k < 0 (item 31).
+Expr perturbation(const Expr& perturbingQuadric, double factor);
 /// Vyatkin perturbation (seed 003 eq. 2-3, with the signed factor of papers.md E9):
 /// F' = F + sum_i k_i R_i, R_i = Q_i^3 where Q_i >= 0, else 0. The quadrics (any shapes, in
 /// fact) must share the base's domain; k_i = 1 is eq. (3), k_i < 0 carves.

@@ -5,6 +5,7 @@
 
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
+#include "Lang/Scene.h"
 #include "Lang/VmReader.h"
 
 #include "FRep/Bounds.h"
@@ -34,7 +35,8 @@ enum class Format
   Unknown,
   HyperFun,
   Xml,
-  Vm
+  Vm,
+  Scene
 };
 
 Format formatOf(const std::string& path)
@@ -56,14 +58,18 @@ Format formatOf(const std::string& path)
   {
     return Format::Vm;
   }
+  if (ext == ".scn" || ext == ".scene")
+  {
+    return Format::Scene;
+  }
   return Format::Unknown;
 }
 
 [[noreturn]] void unknownExtension(const std::string& path)
 {
   throw std::invalid_argument("'" + path +
-    "' is not a model file: the extension must be .hf (HyperFun), .xml (FRep XML) or .vm (Fidget "
-    "SSA, read only)");
+    "' is not a model file: the extension must be .hf (HyperFun), .xml (FRep XML), .scn (a "
+    "scene) or .vm (Fidget SSA, read only)");
 }
 
 // A HyperFun body name made from any model name: letters, digits and '_', starting with a letter.
@@ -169,6 +175,11 @@ bool isModelFile(const std::string& path)
   return formatOf(path) != Format::Unknown;
 }
 
+bool isSceneFile(const std::string& path)
+{
+  return formatOf(path) == Format::Scene;
+}
+
 ModelFile loadModelFile(
   const std::string& path, const Limits& limits, const std::vector<double>& parameterValues)
 {
@@ -187,6 +198,13 @@ ModelFile loadModelFile(
       std::string name = std::filesystem::path(path).stem().string();
       return ModelFile{ name, 0,
         frep::Hypervolume(frep::Shape(std::move(vm.function), domain, name)), std::nullopt };
+    }
+    case Format::Scene:
+    {
+      // Seed 003's scenes (Lang/Scene.h): the solid with its "object" ids and colours.
+      BuiltScene scene = buildScene(readSceneFile(path, limits));
+      return ModelFile{ std::filesystem::path(path).stem().string(), 0, std::move(scene.model),
+        std::nullopt };
     }
     case Format::Xml:
     {
@@ -241,6 +259,11 @@ ModelFile loadModelFile(
   }
 }
 
+void saveSceneFile(const std::string& input, const std::string& path, const Limits& limits)
+{
+  writeAtomically(path, writeScene(readSceneFile(input, limits)));
+}
+
 void saveModelFile(const ModelFile& model, const std::string& path)
 {
   std::string text;
@@ -255,6 +278,9 @@ void saveModelFile(const ModelFile& model, const std::string& path)
       break;
     case Format::Vm:
       throw std::invalid_argument("cannot save '" + path + "': .vm files are read only");
+    case Format::Scene:
+      throw std::invalid_argument("cannot save '" + path +
+        "': a scene is written only from a scene (saveSceneFile; `ictk convert in.scn out.scn`)");
     default:
       unknownExtension(path);
   }

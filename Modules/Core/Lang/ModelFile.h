@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML); .vm (Fidget's
-// SSA benchmark format, negated on import) is read only.
+// Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML); .scn and
+// .scene (seed 003's scenes, Lang/Scene.h) are read, and written only from a scene
+// (saveSceneFile); .vm (Fidget's SSA benchmark format, negated on import) is read only.
 
 #include "FRep/Hypervolume.h"
 #include "Lang/Diagnostics.h"
@@ -23,11 +24,14 @@ struct ModelFile
   std::optional<std::array<double, 6>> bounds;
 };
 
-/// True for paths ending in .hf, .xml or .vm (case-insensitive).
+/// True for paths ending in .hf, .xml, .scn, .scene or .vm (case-insensitive).
 bool isModelFile(const std::string& path);
-/// Opens a .hf or .xml file; throws ParseError (diagnostics name the file) or
+/// True for paths ending in .scn or .scene (case-insensitive): seed 003's scenes (Lang/Scene.h).
+bool isSceneFile(const std::string& path);
+/// Opens a .hf, .xml, .scn or .vm file; throws ParseError (diagnostics name the file) or
 /// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model
-/// (see readHyperFun); an XML model keeps its parameter slots.
+/// (see readHyperFun); an XML model keeps its parameter slots. A scene is its built hypervolume
+/// (lang::buildScene: the attributes "object", "colour", "perturbation").
 ModelFile loadModelFile(const std::string& path, const Limits& limits = {},
   const std::vector<double>& parameterValues = {});
 /// A box {xmin, xmax, ymin, ymax, zmin, zmax} that holds the model: the file's own bounds when it
@@ -38,5 +42,8 @@ std::array<double, 6> modelFileBounds(
   const ModelFile& file, const std::vector<double>& parameters = {});
 /// Saves as .hf or .xml by extension, through a temporary file renamed on success.
 void saveModelFile(const ModelFile& model, const std::string& path);
+/// Writes the scene file `input` as one self-contained scene file `path` (its `object`
+/// references inlined, seed 003 line 157), atomically as saveModelFile.
+void saveSceneFile(const std::string& input, const std::string& path, const Limits& limits = {});
 
 } // namespace ictk::lang

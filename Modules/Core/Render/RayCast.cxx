@@ -827,4 +827,73 @@ RayCastResult rayCast(const frep::Hypervolume& model, const Box3& box, const Cam
   return castModel(frep::Tape::compile(model.geometry().function()), &model, box, camera, options);
 }
 
+Pick pick(const frep::Hypervolume& model, const Box3& box, const Camera& camera, int i, int j,
+  const std::string& attribute, const RayCastOptions& options)
+{
+  if (i < 0 || j < 0 || i >= camera.width() || j >= camera.height())
+  {
+    throw std::invalid_argument("pick: the pixel (" + std::to_string(i) + ", " + std::to_string(j) +
+      ") is outside the " + std::to_string(camera.width()) + " x " +
+      std::to_string(camera.height()) + " picture");
+  }
+  std::size_t offset = 0;
+  std::size_t count = 0;
+  for (const frep::Attribute& a : model.attributes())
+  {
+    if (a.name == attribute)
+    {
+      count = a.components.size();
+      break;
+    }
+    offset += a.components.size();
+  }
+  if (count == 0 && !attribute.empty())
+  {
+    attributeOf(model, attribute); // throws, naming the attributes the model has
+  }
+  // A one-pixel camera whose centre ray is the pixel's ray and whose pixel is as large: the same
+  // search as the picture's at that pixel.
+  const double u = camera.u(i);
+  const double v = camera.v(j);
+  const Point3 origin = camera.origin(u, v);
+  Point3 direction = camera.direction(u, v);
+  const double length = std::sqrt(
+    direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
+  for (double& c : direction)
+  {
+    c /= length;
+  }
+  const Point3 focal{ origin[0] + direction[0], origin[1] + direction[1],
+    origin[2] + direction[2] };
+  const bool perspective = camera.projection() == Projection::Perspective;
+  const double degrees = 180 / 3.14159265358979323846;
+  const Camera one = Camera::lookAt(origin, focal, camera.up(), camera.projection(),
+    perspective ? 2 * std::atan(0.5 * camera.pixelSize()) * degrees : 30,
+    perspective ? 1 : 0.5 * camera.pixelSize(), 1, 1);
+  RayCastOptions single = options;
+  single.tileSize = 1;
+  single.colours = {};
+  const RayCastResult r =
+    rayCast(frep::Tape::compile(model.geometry().function()), box, one, single);
+  Pick result;
+  if (!std::isfinite(r.depth[0]))
+  {
+    return result;
+  }
+  result.hit = true;
+  result.depth = r.depth[0];
+  for (int a = 0; a < 3; ++a)
+  {
+    result.point[a] = origin[a] + r.depth[0] * direction[a];
+  }
+  frep::HypervolumeEvaluator evaluator(model, options.parameters);
+  std::vector<double> values(model.attributeComponentCount());
+  double f = 0;
+  evaluator.eval(
+    { result.point[0], result.point[1], result.point[2], options.time }, f, values.data());
+  result.values.assign(values.begin() + static_cast<std::ptrdiff_t>(offset),
+    values.begin() + static_cast<std::ptrdiff_t>(offset + count));
+  return result;
+}
+
 } // namespace ictk::render

@@ -68,6 +68,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace ictk::render
@@ -131,5 +132,26 @@ RayCastResult rayCast(const frep::TapePtr& field, const frep::Box3& box, const C
 /// colour map or a reversed range.
 RayCastResult rayCast(const frep::Hypervolume& model, const frep::Box3& box, const Camera& camera,
   const RayCastOptions& options = {});
+
+/// What a picture shows at one pixel (picking, seed 003 item 38).
+struct Pick
+{
+  bool hit = false;
+  /// Distance along the pixel's ray to the surface, as RayCastResult::depth (+infinity: none).
+  double depth = std::numeric_limits<double>::infinity();
+  /// The surface point found on the pixel's ray.
+  frep::Point3 point{ 0, 0, 0 };
+  /// The components of the attribute asked for at that point (empty when nothing is hit).
+  std::vector<double> values;
+};
+
+/// The frontmost surface of the model on the ray through pixel (i, j) (row 0 at the bottom, as
+/// in RayCastResult), found by the same ray cast as the picture's (a one-pixel camera on that
+/// ray), and the model's attribute `attribute` there: for a scene (Lang/Scene.h) the attribute
+/// "object" is the id of the frontmost object; an empty name asks for no attribute. Throws
+/// std::invalid_argument for a pixel outside the camera's picture, an attribute the model does not
+/// have, and what rayCast throws for.
+Pick pick(const frep::Hypervolume& model, const frep::Box3& box, const Camera& camera, int i, int j,
+  const std::string& attribute = "object", const RayCastOptions& options = {});
 
 } // namespace ictk::render
