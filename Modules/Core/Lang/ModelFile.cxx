@@ -3,6 +3,7 @@
 // FRep XML stores them.
 #include "Lang/ModelFile.h"
 
+#include "Lang/BlobReader.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 #include "Lang/VmReader.h"
@@ -34,7 +35,8 @@ enum class Format
   Unknown,
   HyperFun,
   Xml,
-  Vm
+  Vm,
+  Blob
 };
 
 Format formatOf(const std::string& path)
@@ -56,14 +58,18 @@ Format formatOf(const std::string& path)
   {
     return Format::Vm;
   }
+  if (ext == ".blob")
+  {
+    return Format::Blob;
+  }
   return Format::Unknown;
 }
 
 [[noreturn]] void unknownExtension(const std::string& path)
 {
   throw std::invalid_argument("'" + path +
-    "' is not a model file: the extension must be .hf (HyperFun), .xml (FRep XML) or .vm (Fidget "
-    "SSA, read only)");
+    "' is not a model file: the extension must be .hf (HyperFun), .xml (FRep XML), .vm (Fidget "
+    "SSA, read only) or .blob (BlobTree, read only)");
 }
 
 // A HyperFun body name made from any model name: letters, digits and '_', starting with a letter.
@@ -188,6 +194,23 @@ ModelFile loadModelFile(
       return ModelFile{ name, 0,
         frep::Hypervolume(frep::Shape(std::move(vm.function), domain, name)), std::nullopt };
     }
+    case Format::Blob:
+    {
+      // A BlobTree at time 0, its field mapped to f >= 0 inside (frep::blob::shape); the bounds
+      // are its support box, where every element's field vanishes, with a 2 % margin.
+      const frep::blob::BlobTree tree = readBlobFile(path, limits).instantiate(0.0);
+      std::string name = std::filesystem::path(path).stem().string();
+      const auto box = frep::blob::supportBox(tree);
+      std::array<double, 6> bounds{};
+      for (int a = 0; a < 3; ++a)
+      {
+        const double pad = 0.02 * (box[1][a] - box[0][a]);
+        bounds[2 * a] = box[0][a] - pad;
+        bounds[2 * a + 1] = box[1][a] + pad;
+      }
+      return ModelFile{ name, 0, frep::Hypervolume(frep::blob::shape(tree).withLabel(name)),
+        bounds };
+    }
     case Format::Xml:
     {
       // readFRepXmlFile's checks (readable, size) first, then the full document.
@@ -255,6 +278,10 @@ void saveModelFile(const ModelFile& model, const std::string& path)
       break;
     case Format::Vm:
       throw std::invalid_argument("cannot save '" + path + "': .vm files are read only");
+    case Format::Blob:
+      throw std::invalid_argument("cannot save '" + path +
+        "': .blob files are read only (a BlobTree is written by hand or generated; see "
+        "docs/blobtree.md)");
     default:
       unknownExtension(path);
   }

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML); .vm (Fidget's
-// SSA benchmark format, negated on import) is read only.
+// SSA benchmark format, negated on import) and .blob (a BlobTree, mapped to f >= 0 inside by
+// frep::blob::shape) are read only.
 
 #include "FRep/Hypervolume.h"
 #include "Lang/Diagnostics.h"
@@ -23,7 +24,7 @@ struct ModelFile
   std::optional<std::array<double, 6>> bounds;
 };
 
-/// True for paths ending in .hf, .xml or .vm (case-insensitive).
+/// True for paths ending in .hf, .xml, .vm or .blob (case-insensitive).
 bool isModelFile(const std::string& path);
 /// Opens a .hf or .xml file; throws ParseError (diagnostics name the file) or
 /// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model
