@@ -557,28 +557,38 @@ void checkValues(Kind kind, const double* v, std::uint32_t count)
   }
 }
 
-// Catmull-Rom through the control points (x, y, z, r), uniform parameter u in [0, count - 1],
-// one-sided tangents at the ends. Written as p0 + h01 (p1 - p0) + h10 m0 + h11 m1 so that a
-// constant radius stays bit-exact (the leaf rules of papers.md 3.4 compare radii exactly).
-std::array<double, 4> curvePoint(const double* ctrl, std::uint32_t count, double u)
+// Catmull-Rom through the control points (x, y, z, r), uniform parameter u in [0, count - 1]:
+// the tangent at a control point is half the difference of its neighbours, one-sided at the ends.
+// Written as p0 + h01 (p1 - p0) + h10 m0 + h11 m1 so that a constant radius stays bit-exact (the
+// leaf rules of papers.md 3.4 compare radii exactly). `tangents` receives 4 count values.
+void curveTangents(const double* ctrl, std::uint32_t count, double* tangents)
 {
-  const auto at = [&](std::int64_t i) -> const double*
+  for (std::uint32_t i = 0; i < count; ++i)
   {
-    return ctrl + 4 * std::clamp<std::int64_t>(i, 0, count - 1);
-  };
-  std::int64_t i = std::min<std::int64_t>(static_cast<std::int64_t>(u), count - 2);
+    const double* before = ctrl + 4 * (i == 0 ? 0 : i - 1);
+    const double* after = ctrl + 4 * (i + 1 == count ? i : i + 1);
+    const double f = (i == 0 || i + 1 == count) ? 1.0 : 0.5;
+    for (int k = 0; k < 4; ++k)
+    {
+      tangents[4 * i + k] = f * (after[k] - before[k]);
+    }
+  }
+}
+
+std::array<double, 4> curvePoint(
+  const double* ctrl, const double* tangents, std::uint32_t count, double u)
+{
+  const std::uint32_t i = std::min(static_cast<std::uint32_t>(u), count - 2);
   const double s = u - static_cast<double>(i);
   const double h01 = s * s * (3 - 2 * s);
   const double h10 = s * (1 - s) * (1 - s);
   const double h11 = s * s * (s - 1);
+  const double* p0 = ctrl + 4 * i;
+  const double* m0 = tangents + 4 * i;
   std::array<double, 4> out{};
   for (int k = 0; k < 4; ++k)
   {
-    const double p0 = at(i)[k];
-    const double p1 = at(i + 1)[k];
-    const double m0 = (i == 0) ? p1 - p0 : 0.5 * (p1 - at(i - 1)[k]);
-    const double m1 = (i + 2 >= count) ? p1 - p0 : 0.5 * (at(i + 2)[k] - p0);
-    out[k] = p0 + h01 * (p1 - p0) + h10 * m0 + h11 * m1;
+    out[k] = p0[k] + h01 * (p0[4 + k] - p0[k]) + h10 * m0[k] + h11 * m0[4 + k];
   }
   out[3] = std::max(out[3], 0.0);
   return out;
@@ -954,19 +964,12 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     const double* nv = v.data() + n.firstValue;
     if (n.kind != Kind::GeneralisedCylinder)
     {
-      std::uint32_t kids[3];
-      std::vector<std::uint32_t> many;
-      std::uint32_t* c = kids;
-      if (n.childCount > 3)
-      {
-        many.resize(n.childCount);
-        c = many.data();
-      }
+      map[i] = push(n.kind, nv, n.valueCount, nullptr, 0);
       for (std::uint32_t k = 0; k < n.childCount; ++k)
       {
-        c[k] = map[links_[n.firstChild + k]];
+        out.links_.push_back(map[links_[n.firstChild + k]]);
       }
-      map[i] = push(n.kind, nv, n.valueCount, c, n.childCount);
+      out.nodes_.back().childCount = n.childCount;
       continue;
     }
     // Generalised cylinder (papers.md 3.4, lines 118-125): n segments of the sampled curve, a
@@ -975,11 +978,14 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     const auto segments = static_cast<std::uint32_t>(nv[2]);
     const std::uint32_t controls = (n.valueCount - 3) / 4;
     level.clear();
-    std::array<double, 4> prev = curvePoint(nv + 3, controls, 0.0);
+    std::vector<double>& tangents = out.tangents_;
+    tangents.resize(4 * controls);
+    curveTangents(nv + 3, controls, tangents.data());
+    std::array<double, 4> prev = curvePoint(nv + 3, tangents.data(), controls, 0.0);
     for (std::uint32_t s = 1; s <= segments; ++s)
     {
-      const std::array<double, 4> cur = curvePoint(
-        nv + 3, controls, static_cast<double>(controls - 1) * s / static_cast<double>(segments));
+      const std::array<double, 4> cur = curvePoint(nv + 3, tangents.data(), controls,
+        static_cast<double>(controls - 1) * s / static_cast<double>(segments));
       if (prev[3] == cur[3])
       {
         if (prev[3] == 0)

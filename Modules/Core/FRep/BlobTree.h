@@ -48,12 +48,12 @@ enum class Kind : std::uint8_t
               // ---
   GeneralisedCylinder, ///< R i n | (v r)...  (control points with radii, >= 2; n >= 1 segments)
                        // --- operators ---
-  Blend,        ///< sum of >= 1 children (papers.md 3.3, line 66)
-  HyperBlend,   ///< n | (sum f^n)^(1/n) of >= 1 children, n > 0 (line 70)
-  LocalBlend,   ///< three children A, B, R (line 74), f_R clamped to [0, 1]
-  Union,        ///< >= 1 children (max, or the R-function under a blend: line 92)
-  Intersection, ///< >= 1 children (min, or the R-function under a blend)
-  Difference,   ///< two children: A \ B = A intersect (2T - f_B) (line 84)
+  Blend,               ///< sum of >= 1 children (papers.md 3.3, line 66)
+  HyperBlend,          ///< n | (sum f^n)^(1/n) of >= 1 children, n > 0 (line 70)
+  LocalBlend,          ///< three children A, B, R (line 74), f_R clamped to [0, 1]
+  Union,               ///< >= 1 children (max, or the R-function under a blend: line 92)
+  Intersection,        ///< >= 1 children (min, or the R-function under a blend)
+  Difference,          ///< two children: A \ B = A intersect (2T - f_B) (line 84)
               // --- warps and frame nodes (one child; f_w(A)(p) = f_A(w^-1(p)), line 96) ---
   Translate, ///< t
   Rotate,    ///< axis angle (radians, right-handed, the axis non-zero)
@@ -158,6 +158,7 @@ private:
   std::vector<bool> parented_;                // add(): which nodes already have a parent
   std::vector<double> scratch_;               // instantiate(): the values at t
   std::vector<std::uint32_t> map_;            // instantiate(): node of the source -> node here
+  std::vector<double> tangents_;              // instantiate(): a curve's control tangents
 };
 
 /// The paper's field f(p) (>= T inside) as an expression of x, y, z. Booleans follow the context
