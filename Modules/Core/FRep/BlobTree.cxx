@@ -494,7 +494,7 @@ void checkValues(Kind kind, const double* v, std::uint32_t count)
   {
     requirePositive(kind, "the radius of influence R", v[0]);
   }
-  const double* s = v + 2;
+  const double* s = count >= 2 ? v + 2 : v; // an operator may have no values (v null)
   switch (kind)
   {
     case Kind::Circle:

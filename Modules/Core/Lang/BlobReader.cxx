@@ -457,17 +457,24 @@ private:
     {
       values[0] *= degree;
     }
+    // Every skeletal element lowers to some 64 expression nodes: bound them before building.
+    std::size_t elements = frep::blob::isSkeletal(*kind) ? 1 : 0;
+    if (*kind == Kind::Curve && values.size() >= 8)
+    {
+      elements = (values.size() - 5) / 3;
+    }
     if (*kind == Kind::GeneralisedCylinder && values.size() >= 3 && values[2] >= 1 &&
       values[2] <= 100000)
     {
-      expandedLeaves_ += static_cast<std::size_t>(values[2]);
-      if (expandedLeaves_ * 64 > limits_.maxExpressionNodes)
-      {
-        report(at,
-          "the generalised cylinders expand to more than " +
-            std::to_string(limits_.maxExpressionNodes / 64) + " elements");
-        return invalid;
-      }
+      elements = static_cast<std::size_t>(values[2]);
+    }
+    expandedLeaves_ += elements;
+    if (expandedLeaves_ * 64 > limits_.maxExpressionNodes)
+    {
+      report(at,
+        "the tree expands to more than " + std::to_string(limits_.maxExpressionNodes / 64) +
+          " skeletal elements");
+      return invalid;
     }
     try
     {
