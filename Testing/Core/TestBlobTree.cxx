@@ -355,6 +355,11 @@ TEST(BlobTree, ContextDependentBooleans)
   const double fa = wyvillByHand(1.2, 3), fb = wyvillByHand(0.8, 3);
   EXPECT_NEAR(evaluate(root, { 0.2, 0, 0 }), std::max(fa, fb), 1e-15);
   EXPECT_NEAR(evaluate(below, { 0.2, 0, 0 }), unionR(fa, fb, 0.5), 1e-15);
+  BlobTree maxBelow; // the max node ignores the context
+  const auto ma = maxBelow.add(Kind::Point, { 3, 1, -1, 0, 0 });
+  const auto mb = maxBelow.add(Kind::Point, { 3, 1, 1, 0, 0 });
+  maxBelow.add(Kind::Blend, {}, { maxBelow.add(Kind::Max, {}, { ma, mb }) });
+  EXPECT_NEAR(evaluate(maxBelow, { 0.2, 0, 0 }), std::max(fa, fb), 1e-15);
   auto sign = [](double v)
   {
     return (v > 0) - (v < 0);
@@ -422,7 +427,7 @@ TEST(BlobTree, GeneralisedCylinderLevelOfDetail)
   {
     const BlobTree t = cylinder(n, 0.3, 0.3, 0.3);
     EXPECT_EQ(t.leafCount(), std::size_t(n));
-    EXPECT_EQ(t.count(Kind::Union), std::size_t(n - 1));
+    EXPECT_EQ(t.count(Kind::Max), std::size_t(n - 1));  // unions that stay max below blends
     EXPECT_EQ(t.operatorCount(), std::size_t(n - 1));   // union only
     EXPECT_EQ(t.count(Kind::Cylinder), std::size_t(n)); // r_i == r_i+1 > 0
   }

@@ -383,6 +383,15 @@ struct Walker
         }
         return f;
       }
+      case Kind::Max:
+      {
+        S f = (*this)(c[0], p, blendBelow);
+        for (std::uint32_t k = 1; k < node.childCount; ++k)
+        {
+          f = max(f, (*this)(c[k], p, blendBelow));
+        }
+        return f;
+      }
       case Kind::Difference:
       {
         const S a = (*this)(c[0], p, blendBelow);
@@ -451,6 +460,7 @@ const Rule& rule(Kind kind)
     { "union", 0, 0, 0, 1, 0 },
     { "intersection", 0, 0, 0, 1, 0 },
     { "difference", 0, 0, 0, 2, 2 },
+    { "max", 0, 0, 0, 1, 0 },
     { "translate", 3, 0, 0, 1, 1 },
     { "rotate", 4, 0, 0, 1, 1 },
     { "scale", 3, 0, 0, 1, 1 },
@@ -974,7 +984,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     }
     // Generalised cylinder (papers.md 3.4, lines 118-125): n segments of the sampled curve, a
     // cone-sphere where the end radii differ, a line-swept sphere where they are equal, a
-    // segment where both are null, under a balanced tree of binary unions.
+    // segment where both are null, under a balanced tree of binary unions (max: Kind::Max).
     const auto segments = static_cast<std::uint32_t>(nv[2]);
     const std::uint32_t controls = (n.valueCount - 3) / 4;
     level.clear();
@@ -1014,7 +1024,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
       next.clear();
       for (std::size_t k = 0; k + 1 < level.size(); k += 2)
       {
-        next.push_back(push(Kind::Union, nullptr, 0, &level[k], 2));
+        next.push_back(push(Kind::Max, nullptr, 0, &level[k], 2));
       }
       if (level.size() % 2)
       {

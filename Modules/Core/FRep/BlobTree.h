@@ -54,7 +54,12 @@ enum class Kind : std::uint8_t
   Union,               ///< >= 1 children (max, or the R-function under a blend: line 92)
   Intersection,        ///< >= 1 children (min, or the R-function under a blend)
   Difference,          ///< two children: A \ B = A intersect (2T - f_B) (line 84)
-              // --- warps and frame nodes (one child; f_w(A)(p) = f_A(w^-1(p)), line 96) ---
+              /// The max of >= 1 children in every context: the union that joins the pieces of a
+              /// complex primitive (papers.md 3.4, line 114: no bulging). Below a blend, a union
+              /// node becomes the R-function, whose value inside grows by up to (2 + sqrt 2)/(2 -
+              /// sqrt 2) = 5.83 per level (same surface); max keeps deep hierarchies well scaled.
+  Max,
+  // --- warps and frame nodes (one child; f_w(A)(p) = f_A(w^-1(p)), line 96) ---
   Translate, ///< t
   Rotate,    ///< axis angle (radians, right-handed, the axis non-zero)
   Scale,     ///< s (three non-zero factors; the field is not rescaled)
