@@ -496,6 +496,36 @@ TEST(BlobTree, AnimationAndInstantiation)
   EXPECT_DOUBLE_EQ(i5.values(i5.root())[3], 0.5); // sin(pi / 2)
   EXPECT_NE(evaluate(i0, { 0.5, 0.3, 0 }), evaluate(i5, { 0.5, 0.3, 0 }));
 
+  // An instance rewritten in place equals a fresh one, also when a cylinder's element kinds
+  // change with its radii (equal radii at t = 0: line-swept spheres; cone-spheres after).
+  BlobTree changing;
+  const auto cg =
+    changing.add(Kind::GeneralisedCylinder, { 0.5, 1, 5, 0, 0, 0, 0.2, 1, 0, 0, 0.2 });
+  changing.add(Kind::Blend, {}, { changing.add(Kind::Point, { 1, 1, 0, 1, 0 }), cg });
+  Animation growing;
+  growing.type = Animation::Type::Keys;
+  growing.order = 1;
+  growing.keys = { { 0, 0.2 }, { 1, 0.4 } };
+  changing.animate(cg, 10, growing);
+  BlobTree reused;
+  for (const double t : { 0.0, 0.5, 0.0, 1.0 })
+  {
+    changing.instantiate(t, reused);
+    const BlobTree fresh = changing.instantiate(t);
+    ASSERT_EQ(reused.nodes().size(), fresh.nodes().size());
+    for (std::uint32_t k = 0; k < fresh.nodes().size(); ++k)
+    {
+      ASSERT_EQ(reused.node(k).kind, fresh.node(k).kind);
+      ASSERT_EQ(reused.node(k).valueCount, fresh.node(k).valueCount);
+      for (std::uint32_t j = 0; j < fresh.node(k).valueCount; ++j)
+      {
+        ASSERT_EQ(reused.values(k)[j], fresh.values(k)[j]);
+      }
+    }
+    EXPECT_EQ(reused.count(Kind::Cylinder), t == 0 ? 5u : 0u);
+    EXPECT_EQ(evaluate(reused, { 0.5, 0.1, 0.1 }), evaluate(fresh, { 0.5, 0.1, 0.1 }));
+  }
+
   // Item 58: order 2 is cubic per span (4th differences vanish), order 3 quintic.
   Animation cubic = keys;
   cubic.keys = { { 0, 1, -2 }, { 2, 3, 1 }, { 3, -1, 0 } };

@@ -6,6 +6,7 @@
 #include "FRep/BlobTree.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -804,6 +805,7 @@ std::uint32_t BlobTree::add(
   links_.insert(links_.end(), children.begin(), children.end());
   nodes_.push_back(node);
   parented_.push_back(false);
+  touch();
   root_ = static_cast<std::uint32_t>(nodes_.size() - 1);
   return root_;
 }
@@ -816,6 +818,7 @@ void BlobTree::setRoot(std::uint32_t node)
       "blobtree: root " + std::to_string(node) + " is not a node of the tree");
   }
   root_ = node;
+  touch();
 }
 
 void BlobTree::animate(std::uint32_t node, std::uint32_t index, Animation animation)
@@ -882,7 +885,9 @@ void BlobTree::clear()
   parented_.clear();
   animations_.clear();
   thresholdAnimation_.clear();
+  pieces_.clear();
   root_ = 0;
+  touch();
 }
 
 namespace
@@ -934,15 +939,59 @@ std::size_t BlobTree::count(Kind kind) const
   return n;
 }
 
+namespace
+{
+// Every change to a tree's structure takes a new number, so that an instance knows whether it
+// was laid out from the structure it is asked to hold again.
+std::atomic<std::uint64_t> structures{ 0 };
+
+// A generalised cylinder's element between two samples (x, y, z, r): its kind by the rule of
+// papers.md 3.4 and its values, written into a slot of 10.
+Kind cylinderPiece(const double* nv, const std::array<double, 4>& a, const std::array<double, 4>& b,
+  double* out, std::uint32_t& count)
+{
+  out[0] = nv[0];
+  out[1] = nv[1];
+  out[2] = a[0];
+  out[3] = a[1];
+  out[4] = a[2];
+  out[5] = b[0];
+  out[6] = b[1];
+  out[7] = b[2];
+  if (a[3] != b[3])
+  {
+    out[8] = a[3];
+    out[9] = b[3];
+    count = 10;
+    return Kind::ConeSphere;
+  }
+  out[8] = b[3];
+  count = b[3] == 0 ? 8 : 9;
+  return b[3] == 0 ? Kind::Segment : Kind::Cylinder;
+}
+} // namespace
+
+void BlobTree::touch()
+{
+  structure_ = ++structures;
+  instanceOf_ = 0;
+}
+
 void BlobTree::instantiate(double t, BlobTree& out) const
 {
-  out.clear();
-  out.threshold_ = threshold_;
+  double threshold = threshold_;
   if (!thresholdAnimation_.empty())
   {
     const double T = thresholdAnimation_[0].eval(t);
-    out.threshold_ = T > 0 && std::isfinite(T) ? T : threshold_;
+    threshold = T > 0 && std::isfinite(T) ? T : threshold_;
   }
+  // The instance keeps its layout when it was made from this structure: only values change.
+  const bool relayout = out.instanceOf_ == 0 || out.instanceOf_ != structure_;
+  if (relayout)
+  {
+    out.clear();
+  }
+  out.threshold_ = threshold;
   if (nodes_.empty())
   {
     return;
@@ -955,26 +1004,34 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     v[a.value] = a.animation.eval(t);
   }
   std::vector<std::uint32_t>& map = out.map_;
-  map.assign(nodes_.size(), 0);
-  out.nodes_.reserve(nodes_.size());
-  out.values_.reserve(values_.size());
-  auto push = [&out](Kind kind, const double* values, std::uint32_t count,
+  if (relayout)
+  {
+    map.assign(nodes_.size(), 0);
+    out.pieces_.clear();
+  }
+  auto push = [&out](Kind kind, const double* values, std::uint32_t count, std::uint32_t slot,
                 const std::uint32_t* children, std::uint32_t childCount)
   {
     out.nodes_.push_back({ kind, static_cast<std::uint32_t>(out.values_.size()), count,
       static_cast<std::uint32_t>(out.links_.size()), childCount });
-    out.values_.insert(out.values_.end(), values, values + count);
+    out.values_.insert(out.values_.end(), values, values + slot);
     out.links_.insert(out.links_.end(), children, children + childCount);
     return static_cast<std::uint32_t>(out.nodes_.size() - 1);
   };
   std::vector<std::uint32_t> level, next;
+  std::size_t piece = 0;
   for (std::uint32_t i = 0; i < nodes_.size(); ++i)
   {
     const Node& n = nodes_[i];
     const double* nv = v.data() + n.firstValue;
     if (n.kind != Kind::GeneralisedCylinder)
     {
-      map[i] = push(n.kind, nv, n.valueCount, nullptr, 0);
+      if (!relayout)
+      {
+        std::copy(nv, nv + n.valueCount, out.values_.data() + out.nodes_[map[i]].firstValue);
+        continue;
+      }
+      map[i] = push(n.kind, nv, n.valueCount, n.valueCount, nullptr, 0);
       for (std::uint32_t k = 0; k < n.childCount; ++k)
       {
         out.links_.push_back(map[links_[n.firstChild + k]]);
@@ -984,47 +1041,46 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     }
     // Generalised cylinder (papers.md 3.4, lines 118-125): n segments of the sampled curve, a
     // cone-sphere where the end radii differ, a line-swept sphere where they are equal, a
-    // segment where both are null, under a balanced tree of binary unions (max: Kind::Max).
+    // segment where both are null, under a balanced tree of binary unions (max: Kind::Max). Each
+    // element has a slot of 10 values, so that a kind changing with t keeps the layout.
     const auto segments = static_cast<std::uint32_t>(nv[2]);
     const std::uint32_t controls = (n.valueCount - 3) / 4;
-    level.clear();
     std::vector<double>& tangents = out.tangents_;
     tangents.resize(4 * controls);
     curveTangents(nv + 3, controls, tangents.data());
     std::array<double, 4> prev = curvePoint(nv + 3, tangents.data(), controls, 0.0);
+    level.clear();
     for (std::uint32_t s = 1; s <= segments; ++s)
     {
       const std::array<double, 4> cur = curvePoint(nv + 3, tangents.data(), controls,
         static_cast<double>(controls - 1) * s / static_cast<double>(segments));
-      if (prev[3] == cur[3])
+      double pieceValues[10];
+      std::uint32_t count = 0;
+      const Kind kind = cylinderPiece(nv, prev, cur, pieceValues, count);
+      if (relayout)
       {
-        if (prev[3] == 0)
-        {
-          const double leafValues[8] = { nv[0], nv[1], prev[0], prev[1], prev[2], cur[0], cur[1],
-            cur[2] };
-          level.push_back(push(Kind::Segment, leafValues, 8, nullptr, 0));
-        }
-        else
-        {
-          const double leafValues[9] = { nv[0], nv[1], prev[0], prev[1], prev[2], cur[0], cur[1],
-            cur[2], cur[3] };
-          level.push_back(push(Kind::Cylinder, leafValues, 9, nullptr, 0));
-        }
+        level.push_back(push(kind, pieceValues, count, 10, nullptr, 0));
+        out.pieces_.push_back(level.back());
       }
       else
       {
-        const double leafValues[10] = { nv[0], nv[1], prev[0], prev[1], prev[2], cur[0], cur[1],
-          cur[2], prev[3], cur[3] };
-        level.push_back(push(Kind::ConeSphere, leafValues, 10, nullptr, 0));
+        Node& leaf = out.nodes_[out.pieces_[piece++]];
+        leaf.kind = kind;
+        leaf.valueCount = count;
+        std::copy(pieceValues, pieceValues + 10, out.values_.data() + leaf.firstValue);
       }
       prev = cur;
+    }
+    if (!relayout)
+    {
+      continue;
     }
     while (level.size() > 1)
     {
       next.clear();
       for (std::size_t k = 0; k + 1 < level.size(); k += 2)
       {
-        next.push_back(push(Kind::Max, nullptr, 0, &level[k], 2));
+        next.push_back(push(Kind::Max, nullptr, 0, 0, &level[k], 2));
       }
       if (level.size() % 2)
       {
@@ -1035,6 +1091,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     map[i] = level[0];
   }
   out.root_ = map[root_];
+  out.instanceOf_ = structure_;
 }
 
 BlobTree BlobTree::instantiate(double t) const

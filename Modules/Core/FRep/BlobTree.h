@@ -137,8 +137,9 @@ public:
   std::size_t count(Kind kind) const;
 
   /// The static tree at time t (papers.md 3.6, lines 227-229): every animated value evaluated,
-  /// complex primitives expanded into skeletal elements (expand()). `out` is overwritten (its
-  /// memory is reused, so instantiating many times allocates little).
+  /// complex primitives expanded into skeletal elements (expand()). `out` (not this tree) is
+  /// overwritten; when it already holds an instance of this structure only its values are
+  /// rewritten, so instantiating many times allocates nothing.
   void instantiate(double t, BlobTree& out) const;
   BlobTree instantiate(double t) const;
   /// The same tree with complex primitives expanded (a static tree: animations are dropped).
@@ -148,6 +149,7 @@ public:
   void clear();
 
 private:
+  void touch(); // the structure changed
   double threshold_;
   std::uint32_t root_ = 0;
   std::vector<Node> nodes_;
@@ -163,6 +165,9 @@ private:
   std::vector<bool> parented_;                // add(): which nodes already have a parent
   std::vector<double> scratch_;               // instantiate(): the values at t
   std::vector<std::uint32_t> map_;            // instantiate(): node of the source -> node here
+  std::vector<std::uint32_t> pieces_;         // instantiate(): the elements of the cylinders
+  std::uint64_t structure_ = 0;               // this structure's number
+  std::uint64_t instanceOf_ = 0;              // instantiate(): the structure laid out here
   std::vector<double> tangents_;              // instantiate(): a curve's control tangents
 };
 
