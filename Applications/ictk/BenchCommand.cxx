@@ -314,6 +314,21 @@ Result Csg3(int size)
 
 // --- output -------------------------------------------------------------------------------------
 
+/// Times `mesh` (Options.Runs runs after a warm-up) into r, with the triangle count and the
+/// topology of the last mesh.
+void TimeContour(Result& r, const std::function<discretize::SurfaceMesh()>& mesh)
+{
+  discretize::SurfaceMesh last;
+  r.allSeconds = Time(
+    Options.Runs, [&] { last = mesh(); }, &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  r.work = static_cast<double>(last.triangles.size());
+  const discretize::MeshTopology t = discretize::analyzeTopology(last);
+  r.details["triangles"] = last.triangles.size();
+  r.details["manifold"] = t.manifold();
+  r.details["closed"] = t.closed();
+}
+
 Result SphereGyroid(double featureSize)
 {
   Result r;
@@ -333,19 +348,10 @@ Result SphereGyroid(double featureSize)
   discretize::SurfaceOptions options;
   options.featureSize = featureSize;
   options.threads = r.threads;
-  discretize::SurfaceMesh mesh;
-  r.allSeconds = Time(
-    Options.Runs,
+  TimeContour(r,
     [&] {
-      mesh = discretize::contourSurface(*field, { { -5, -5, -5 }, { 5, 5, 5 } }, options);
-    },
-    &r.cpuSeconds);
-  r.seconds = Median(r.allSeconds);
-  r.work = static_cast<double>(mesh.triangles.size());
-  const discretize::MeshTopology t = discretize::analyzeTopology(mesh);
-  r.details["triangles"] = mesh.triangles.size();
-  r.details["manifold"] = t.manifold();
-  r.details["closed"] = t.closed();
+      return discretize::contourSurface(*field, { { -5, -5, -5 }, { 5, 5, 5 } }, options);
+    });
   return r;
 }
 
@@ -489,24 +495,15 @@ Result TRexMesh(double featureSize)
   // A BlobTree is smooth by design (compact kernels, blends): vertices at the crossings' mass
   // point, no gradients.
   options.sharpFeatures = false;
-  discretize::SurfaceMesh mesh;
-  r.allSeconds = Time(
-    Options.Runs,
+  TimeContour(r,
     [&]
     {
       const frep::FieldPtr field =
         frep::tapeField(frep::Tape::compile(frep::blob::shape(instance).function()));
-      mesh = discretize::contourSurface(*field, { box[0], box[1] }, options);
-    },
-    &r.cpuSeconds);
-  r.seconds = Median(r.allSeconds);
-  r.work = static_cast<double>(mesh.triangles.size());
-  r.details["triangles"] = mesh.triangles.size();
+      return discretize::contourSurface(*field, { box[0], box[1] }, options);
+    });
   r.details["skeletal_elements"] = instance.leafCount();
   r.details["sharp_features"] = false;
-  const discretize::MeshTopology t = discretize::analyzeTopology(mesh);
-  r.details["manifold"] = t.manifold();
-  r.details["closed"] = t.closed();
   return r;
 }
 
