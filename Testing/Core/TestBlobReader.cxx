@@ -205,3 +205,19 @@ TEST(BlobReader, TRexModel)
     EXPECT_NEAR(e.eval(p[0], p[1], p[2]), evaluate(i0, p), 1e-12);
   }
 }
+
+// A TextureTree read from a file: its materials are the model's attributes.
+TEST(BlobReader, TexturedModelHasMaterialAttributes)
+{
+  const lang::ModelFile m = lang::loadModelFile(Models + "textured.blob");
+  const frep::Attribute* colour = m.model.findAttribute("colour");
+  ASSERT_NE(colour, nullptr);
+  ASSERT_NE(m.model.findAttribute("optics"), nullptr);
+  frep::HypervolumeEvaluator e(m.model);
+  double f = 0;
+  std::vector<double> a(m.model.attributeComponentCount());
+  e.eval({ 2, 0, 0, 0 }, f, a.data()); // inside the red part, away from the blue ring
+  EXPECT_GT(f, 0);
+  EXPECT_DOUBLE_EQ(a[0], 0.85);
+  EXPECT_DOUBLE_EQ(a[2], 0.15);
+}

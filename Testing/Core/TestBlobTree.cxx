@@ -572,3 +572,130 @@ TEST(BlobTree, AnimationAndInstantiation)
   EXPECT_NEAR(s0.eval(1, 0, 0), 0, 1e-15); // the surface at R/2 for T = 0.5
   EXPECT_LT(s1.eval(1, 0, 0), 0);          // a higher threshold shrinks it
 }
+
+namespace
+{
+// Points at the origin: at the origin each gives its intensity exactly (g(0) = 1); each under a
+// material node whose six values are `phi`.
+std::uint32_t paintedPoint(BlobTree& t, double intensity, double phi)
+{
+  const auto p = t.add(Kind::Point, { 1, intensity, 0, 0, 0 });
+  return t.add(Kind::Material, { phi, phi, phi, phi, phi, phi }, { p });
+}
+
+double phiAtOrigin(const BlobTree& t, TextureHyperBlend mode = TextureHyperBlend::Corrected)
+{
+  std::array<double, MaterialSize> phi{};
+  evaluateTextured(t, { 0, 0, 0 }, phi, mode);
+  for (int k = 1; k < MaterialSize; ++k)
+  {
+    EXPECT_EQ(phi[k], phi[0]);
+  }
+  // The lowered material gives the same.
+  PointEvaluator e(Tape::compile(material(t, mode)[0]));
+  EXPECT_NEAR(e.eval(0, 0, 0), phi[0], 1e-15);
+  return phi[0];
+}
+
+BlobTree pair(
+  Kind kind, double fa, double fb, double pa, double pb, std::vector<double> values = {})
+{
+  BlobTree t;
+  const auto a = paintedPoint(t, fa, pa);
+  const auto b = paintedPoint(t, fb, pb);
+  t.add(kind, values, { a, b });
+  return t;
+}
+} // namespace
+
+// Items 51-55: the TextureTree's (f, Phi) and its operators, on fields and materials known at the
+// origin.
+TEST(BlobTree, TextureTree)
+{
+  BlobTree leaf;
+  const auto p = leaf.add(Kind::Point, { 2, 1, 0, 0, 0 });
+  leaf.add(Kind::Material, { 0.9, 0.1, 0.2, 0.3, 0.4, 1.5 }, { p });
+  std::array<double, MaterialSize> phi{};
+  EXPECT_DOUBLE_EQ(evaluateTextured(leaf, { 1, 0, 0 }, phi), 0.5); // item 51: (f, Phi)
+  EXPECT_EQ(phi, (std::array<double, MaterialSize>{ 0.9, 0.1, 0.2, 0.3, 0.4, 1.5 }));
+  evaluateTextured(single(Kind::Point, { 1, 1, 0, 0, 0 }), { 0, 0, 0 }, phi);
+  EXPECT_EQ(phi[0], DefaultMaterial[0]);
+
+  EXPECT_NEAR(phiAtOrigin(pair(Kind::Blend, 0.3, 0.6, 0.2, 0.9)), 0.666667, 5e-7); // item 52
+  EXPECT_NEAR(phiAtOrigin(pair(Kind::Blend, 0.4, 0.4, 0.2, 0.9)), 0.55, 1e-15);    // the mean
+
+  // Item 53 and E11: the hyper-blend as printed tends to 0.45, the corrected one to Phi_A.
+  const auto verbatim = TextureHyperBlend::Verbatim;
+  EXPECT_NEAR(
+    phiAtOrigin(pair(Kind::HyperBlend, 0.3, 0.6, 0.2, 0.9, { 1 }), verbatim), 0.666667, 5e-7);
+  EXPECT_NEAR(
+    phiAtOrigin(pair(Kind::HyperBlend, 0.6, 0.3, 0.2, 0.9, { 1 }), verbatim), 0.43333, 5e-6);
+  EXPECT_NEAR(
+    phiAtOrigin(pair(Kind::HyperBlend, 0.6, 0.3, 0.2, 0.9, { 32 }), verbatim), 0.45000, 5e-6);
+  EXPECT_NEAR(phiAtOrigin(pair(Kind::HyperBlend, 0.6, 0.3, 0.2, 0.9, { 1 })), 0.43333, 5e-6);
+  EXPECT_NEAR(phiAtOrigin(pair(Kind::HyperBlend, 0.6, 0.3, 0.2, 0.9, { 32 })), 0.2, 1e-9);
+
+  // Item 54: Booleans pick one child's Phi; ties go to B.
+  EXPECT_EQ(phiAtOrigin(pair(Kind::Union, 0.6, 0.3, 0.2, 0.9)), 0.2);
+  EXPECT_EQ(phiAtOrigin(pair(Kind::Union, 0.3, 0.6, 0.2, 0.9)), 0.9);
+  EXPECT_EQ(phiAtOrigin(pair(Kind::Union, 0.4, 0.4, 0.2, 0.9)), 0.9);
+  EXPECT_EQ(phiAtOrigin(pair(Kind::Intersection, 0.3, 0.6, 0.2, 0.9)), 0.2);
+  EXPECT_EQ(phiAtOrigin(pair(Kind::Intersection, 0.6, 0.3, 0.2, 0.9)), 0.9);
+  EXPECT_EQ(phiAtOrigin(pair(Kind::Difference, 0.3, 0.6, 0.2, 0.9)), 0.2); // 0.3 < 1 - 0.6
+  EXPECT_EQ(phiAtOrigin(pair(Kind::Difference, 0.5, 0.6, 0.2, 0.9)), 0.9);
+
+  // Item 55: the local blend mixes the blend's and the union's Phi by f_R.
+  for (const double w : { 0.0, 0.5, 1.0 })
+  {
+    BlobTree t;
+    const auto a = paintedPoint(t, 0.3, 0.2);
+    const auto b = paintedPoint(t, 0.6, 0.9);
+    const auto r = t.add(Kind::Point, { 1, w, 0, 0, 0 });
+    t.add(Kind::LocalBlend, {}, { a, b, r });
+    EXPECT_NEAR(phiAtOrigin(t), w * (0.3 * 0.2 + 0.6 * 0.9) / 0.9 + (1 - w) * 0.9, 1e-15);
+  }
+}
+
+// The lowered materials agree with the traversal everywhere, and flow into a hypervolume's
+// attributes.
+TEST(BlobTree, TextureTreeLoweredAndAsAttributes)
+{
+  BlobTree t;
+  const auto a = t.add(
+    Kind::Material, { 1, 0, 0, 0.1, 0, 1.2 }, { t.add(Kind::Segment, { 1, 1, 0, 0, 0, 1, 0, 0 }) });
+  const auto b = t.add(Kind::Material, { 0, 0, 1, 0.5, 0.2, 1.4 },
+    { t.add(Kind::Disc, { 0.8, 1, 0.5, 1.5, 0, 0, 1, 0, 0.5 }) });
+  const auto c = t.add(Kind::Point, { 0.9, 1, 0, 0.6, 0.3 });
+  const auto u = t.add(Kind::Union, {}, { a, c });
+  t.add(Kind::Rotate, { 0, 0, 1, 0.4 }, { t.add(Kind::HyperBlend, { 2 }, { u, b }) });
+  const std::array<Expr, MaterialSize> phi = material(t);
+  std::vector<Expr> outputs(phi.begin(), phi.end());
+  PointEvaluator e(Tape::compile(outputs));
+  std::mt19937 rng(56);
+  std::uniform_real_distribution<double> x(-1, 2);
+  for (int k = 0; k < 2000; ++k)
+  {
+    const Vec3 p{ x(rng), x(rng), x(rng) };
+    std::array<double, MaterialSize> expected{}, got{};
+    evaluateTextured(t, p, expected);
+    e.evalAll({ p[0], p[1], p[2], 0 }, got.data());
+    for (int m = 0; m < MaterialSize; ++m)
+    {
+      ASSERT_NEAR(got[m], expected[m], 1e-12);
+    }
+  }
+  const Hypervolume hv = texturedHypervolume(t);
+  ASSERT_NE(hv.findAttribute("colour"), nullptr);
+  HypervolumeEvaluator he(hv);
+  double f = 0;
+  std::vector<double> attributes(hv.attributeComponentCount());
+  he.eval({ 0.5, 0, 0, 0 }, f, attributes.data()); // on the red segment, turned by 0.4 rad
+  const double c0 = std::cos(0.4), s0 = std::sin(0.4);
+  std::array<double, MaterialSize> expected{};
+  evaluateTextured(t, { 0.5, 0, 0 }, expected);
+  EXPECT_NEAR(f, evaluate(t, { 0.5, 0, 0 }) - 0.5, 1e-12);
+  EXPECT_NEAR(attributes[0], expected[0], 1e-12);
+  he.eval({ 0.5 * c0, 0.5 * s0, 0, 0 }, f, attributes.data());
+  EXPECT_DOUBLE_EQ(attributes[0], 1.0); // on the segment, away from the disc: pure red
+  EXPECT_DOUBLE_EQ(attributes[2], 0.0);
+}

@@ -339,68 +339,154 @@ struct Walker
     }
   }
 
+  // A node's field and, when textured, its material (papers.md 3.5): f and Phi in one pass.
+  struct Value
+  {
+    S f;
+    std::array<S, MaterialSize> phi;
+  };
+  bool textured = false;
+  TextureHyperBlend hyperMode = TextureHyperBlend::Corrected;
+
+  // Phi = a if c >= 0, else b, component-wise.
+  static std::array<S, MaterialSize> pick(
+    const S& c, const std::array<S, MaterialSize>& a, const std::array<S, MaterialSize>& b)
+  {
+    std::array<S, MaterialSize> out;
+    for (int k = 0; k < MaterialSize; ++k)
+    {
+      out[k] = select(c, a[k], b[k]);
+    }
+    return out;
+  }
+
   S operator()(std::uint32_t index, const P<S>& p, bool underBlend) const
+  {
+    return value(index, p, underBlend, {}).f;
+  }
+
+  Value value(std::uint32_t index, const P<S>& p, bool underBlend,
+    const std::array<S, MaterialSize>& material) const
   {
     const Node& node = tree.node(index);
     const double* v = tree.values(index);
     const std::uint32_t* c = tree.children(index);
     if (isSkeletal(node.kind))
     {
-      return leaf(node, v, p);
+      return { leaf(node, v, p), material };
     }
     const bool blendBelow = underBlend || isBlend(node.kind);
+    const auto child = [&](std::uint32_t k, const P<S>& q, bool below)
+    {
+      return value(c[k], q, below, material);
+    };
     switch (node.kind)
     {
       case Kind::Blend:
-      {
-        S sum = (*this)(c[0], p, true);
-        for (std::uint32_t k = 1; k < node.childCount; ++k)
-        {
-          sum = sum + (*this)(c[k], p, true);
-        }
-        return sum;
-      }
       case Kind::HyperBlend:
       {
-        S sum = hyperPower((*this)(c[0], p, true), v[0]);
-        for (std::uint32_t k = 1; k < node.childCount; ++k)
+        // f = sum f_i (or (sum f_i^n)^(1/n)); Phi weighted by f_i (line 191), by f_i^n in the
+        // corrected hyper-blend, or (sum f_i^n Phi_i^n)^(1/n) / (sum f_i^n)^(1/n) as printed
+        // (line 195, E11). Where every weight is 0, the mean of the children's Phi.
+        const bool hyper = node.kind == Kind::HyperBlend;
+        const double n = hyper ? v[0] : 1.0;
+        S sum(0.0), weights(0.0);
+        std::array<S, MaterialSize> weighted, mean;
+        weighted.fill(S(0.0));
+        mean.fill(S(0.0));
+        for (std::uint32_t k = 0; k < node.childCount; ++k)
         {
-          sum = sum + hyperPower((*this)(c[k], p, true), v[0]);
+          const Value a = child(k, p, true);
+          const S w = hyper ? hyperPower(a.f, n) : a.f;
+          sum = k == 0 ? w : sum + w;
+          if (!textured)
+          {
+            continue;
+          }
+          weights = weights + w;
+          for (int m = 0; m < MaterialSize; ++m)
+          {
+            const S phi = hyper && hyperMode == TextureHyperBlend::Verbatim
+              ? hyperPower(a.phi[m], n)
+              : a.phi[m];
+            weighted[m] = weighted[m] + w * phi;
+            mean[m] = mean[m] + a.phi[m] * (1.0 / node.childCount);
+          }
         }
-        return pow(sum, S(1.0 / v[0]));
+        Value out{ hyper ? pow(sum, S(1.0 / n)) : sum, material };
+        if (textured)
+        {
+          for (int m = 0; m < MaterialSize; ++m)
+          {
+            const S phi = hyper && hyperMode == TextureHyperBlend::Verbatim
+              ? pow(max(weighted[m] / weights, S(0.0)), S(1.0 / n))
+              : weighted[m] / weights;
+            out.phi[m] = select(-weights, mean[m], phi);
+          }
+        }
+        return out;
       }
       case Kind::LocalBlend:
-        return localBlendOf((*this)(c[0], p, true), (*this)(c[1], p, true), (*this)(c[2], p, true));
+      {
+        const Value a = child(0, p, true), b = child(1, p, true), r = child(2, p, true);
+        Value out{ localBlendOf(a.f, b.f, r.f), material };
+        if (textured) // line 199: w Phi_{A+B} + (1 - w) Phi_{A u B}
+        {
+          const S w = min(max(r.f, S(0.0)), S(1.0));
+          const S total = a.f + b.f;
+          const auto sharp = pick(b.f - a.f, b.phi, a.phi);
+          for (int m = 0; m < MaterialSize; ++m)
+          {
+            const S smooth = select(
+              -total, 0.5 * (a.phi[m] + b.phi[m]), (a.f * a.phi[m] + b.f * b.phi[m]) / total);
+            out.phi[m] = w * smooth + (1.0 - w) * sharp[m];
+          }
+        }
+        return out;
+      }
       case Kind::Union:
       case Kind::Intersection:
-      {
-        const bool isUnion = node.kind == Kind::Union;
-        S f = (*this)(c[0], p, blendBelow);
-        for (std::uint32_t k = 1; k < node.childCount; ++k)
-        {
-          const S g = (*this)(c[k], p, blendBelow);
-          f = blendBelow ? (isUnion ? unionRT(f, g, T) : intersectionRT(f, g, T))
-                         : (isUnion ? max(f, g) : min(f, g));
-        }
-        return f;
-      }
       case Kind::Max:
       {
-        S f = (*this)(c[0], p, blendBelow);
+        // Line 203: the union keeps Phi_A iff f_A > f_B, the intersection iff f_A < f_B; ties B.
+        const bool isUnion = node.kind != Kind::Intersection;
+        const bool rFunction = blendBelow && node.kind != Kind::Max;
+        Value f = child(0, p, blendBelow);
         for (std::uint32_t k = 1; k < node.childCount; ++k)
         {
-          f = max(f, (*this)(c[k], p, blendBelow));
+          const Value g = child(k, p, blendBelow);
+          if (textured)
+          {
+            f.phi = isUnion ? pick(g.f - f.f, g.phi, f.phi) : pick(f.f - g.f, g.phi, f.phi);
+          }
+          f.f = rFunction ? (isUnion ? unionRT(f.f, g.f, T) : intersectionRT(f.f, g.f, T))
+                          : (isUnion ? max(f.f, g.f) : min(f.f, g.f));
         }
         return f;
       }
       case Kind::Difference:
       {
-        const S a = (*this)(c[0], p, blendBelow);
-        const S b = 2.0 * T - (*this)(c[1], p, blendBelow);
-        return blendBelow ? intersectionRT(a, b, T) : min(a, b);
+        const Value a = child(0, p, blendBelow);
+        const Value bv = child(1, p, blendBelow);
+        const S b = 2.0 * T - bv.f;
+        Value out{ blendBelow ? intersectionRT(a.f, b, T) : min(a.f, b), material };
+        if (textured) // Phi_A iff f_A < 2T - f_B
+        {
+          out.phi = pick(a.f - b, bv.phi, a.phi);
+        }
+        return out;
+      }
+      case Kind::Material:
+      {
+        std::array<S, MaterialSize> own;
+        for (int m = 0; m < MaterialSize; ++m)
+        {
+          own[m] = S(v[m]);
+        }
+        return value(c[0], p, blendBelow, own);
       }
       case Kind::Translate:
-        return (*this)(c[0], minus(p, v), blendBelow);
+        return child(0, minus(p, v), blendBelow);
       case Kind::Rotate:
       {
         // w^-1 is the rotation by -angle (Rodrigues).
@@ -410,20 +496,20 @@ struct Walker
         const S kp = dot(p, k);
         const P<S> kxp{ p.z * k[1] - p.y * k[2], p.x * k[2] - p.z * k[0], p.y * k[0] - p.x * k[1] };
         const S w = kp * (1.0 - cs);
-        return (*this)(c[0],
+        return child(0,
           P<S>{ p.x * cs + kxp.x * sn + w * k[0], p.y * cs + kxp.y * sn + w * k[1],
             p.z * cs + kxp.z * sn + w * k[2] },
           blendBelow);
       }
       case Kind::Scale:
-        return (*this)(
-          c[0], P<S>{ p.x * (1.0 / v[0]), p.y * (1.0 / v[1]), p.z * (1.0 / v[2]) }, blendBelow);
+        return child(
+          0, P<S>{ p.x * (1.0 / v[0]), p.y * (1.0 / v[1]), p.z * (1.0 / v[2]) }, blendBelow);
       case Kind::Twist:
       {
         const S a = p.z * v[0];
         const S cs = cos(a);
         const S sn = sin(a);
-        return (*this)(c[0], P<S>{ p.x * cs + p.y * sn, p.y * cs - p.x * sn, p.z }, blendBelow);
+        return child(0, P<S>{ p.x * cs + p.y * sn, p.y * cs - p.x * sn, p.z }, blendBelow);
       }
       default:
         throw std::invalid_argument(
@@ -462,6 +548,7 @@ const Rule& rule(Kind kind)
     { "intersection", 0, 0, 0, 1, 0 },
     { "difference", 0, 0, 0, 2, 2 },
     { "max", 0, 0, 0, 1, 0 },
+    { "material", 6, 0, 0, 1, 1 },
     { "translate", 3, 0, 0, 1, 1 },
     { "rotate", 4, 0, 0, 1, 1 },
     { "scale", 3, 0, 0, 1, 1 },
@@ -547,6 +634,12 @@ void checkValues(Kind kind, const double* v, std::uint32_t count)
     }
     case Kind::HyperBlend:
       requirePositive(kind, "the exponent n", v[0]);
+      break;
+    case Kind::Material:
+      for (int k = 0; k < MaterialSize; ++k)
+      {
+        requireNonNegative(kind, "every material value", v[k]);
+      }
       break;
     case Kind::Rotate:
       if (vdot(vec(v), vec(v)) == 0)
@@ -921,8 +1014,10 @@ std::size_t BlobTree::operatorCount() const
 {
   std::size_t n = 0;
   visitReachable(*this,
-    [&](const Node& node) {
-      n += !isSkeletal(node.kind) && !isWarp(node.kind) && node.kind != Kind::GeneralisedCylinder;
+    [&](const Node& node)
+    {
+      n += !isSkeletal(node.kind) && !isWarp(node.kind) && node.kind != Kind::GeneralisedCylinder &&
+        node.kind != Kind::Material;
     });
   return n;
 }
@@ -1146,6 +1241,69 @@ double evaluate(const BlobTree& tree, const Vec3& p, std::size_t* kernelEvaluati
   const BlobTree& t = expanded(tree, storage);
   const Walker<double> walk{ t, t.threshold(), kernelEvaluations };
   return walk(t.root(), P<double>{ p[0], p[1], p[2] }, false);
+}
+
+namespace
+{
+template <class S>
+std::array<S, MaterialSize> defaultMaterial()
+{
+  return { S(DefaultMaterial[0]), S(DefaultMaterial[1]), S(DefaultMaterial[2]),
+    S(DefaultMaterial[3]), S(DefaultMaterial[4]), S(DefaultMaterial[5]) };
+}
+} // namespace
+
+std::array<Expr, MaterialSize> material(const BlobTree& tree, TextureHyperBlend mode)
+{
+  if (tree.empty())
+  {
+    throw std::invalid_argument("blobtree: the tree is empty");
+  }
+  BlobTree storage;
+  const BlobTree& t = expanded(tree, storage);
+  Walker<Expr> walk{ t, t.threshold(), nullptr };
+  walk.textured = true;
+  walk.hyperMode = mode;
+  return walk
+    .value(t.root(), P<Expr>{ Expr::x(), Expr::y(), Expr::z() }, false, defaultMaterial<Expr>())
+    .phi;
+}
+
+double evaluateTextured(const BlobTree& tree, const Vec3& p, std::array<double, MaterialSize>& phi,
+  TextureHyperBlend mode)
+{
+  if (tree.empty())
+  {
+    throw std::invalid_argument("blobtree: the tree is empty");
+  }
+  BlobTree storage;
+  const BlobTree& t = expanded(tree, storage);
+  Walker<double> walk{ t, t.threshold(), nullptr };
+  walk.textured = true;
+  walk.hyperMode = mode;
+  const auto v =
+    walk.value(t.root(), P<double>{ p[0], p[1], p[2] }, false, defaultMaterial<double>());
+  phi = v.phi;
+  return v.f;
+}
+
+Hypervolume texturedHypervolume(const BlobTree& tree, TextureHyperBlend mode)
+{
+  const std::array<Expr, MaterialSize> phi = material(tree, mode);
+  Hypervolume hv(shape(tree));
+  Attribute colour;
+  colour.name = "colour";
+  colour.components = { phi[0], phi[1], phi[2] };
+  colour.insideDefault = { DefaultMaterial[0], DefaultMaterial[1], DefaultMaterial[2] };
+  colour.outsideDefault = colour.insideDefault;
+  hv.addAttribute(colour);
+  Attribute optics;
+  optics.name = "optics";
+  optics.components = { phi[3], phi[4], phi[5] };
+  optics.insideDefault = { DefaultMaterial[3], DefaultMaterial[4], DefaultMaterial[5] };
+  optics.outsideDefault = optics.insideDefault;
+  hv.addAttribute(optics);
+  return hv;
 }
 
 std::array<Vec3, 2> supportBox(const BlobTree& tree)

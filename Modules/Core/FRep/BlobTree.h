@@ -18,6 +18,7 @@
 // surface lies at distance R/2 from the skeleton.
 
 #include "FRep/Domain.h"
+#include "FRep/Hypervolume.h"
 
 #include <array>
 #include <cstdint>
@@ -30,6 +31,20 @@ using Vec3 = std::array<double, 3>;
 
 /// The threshold T of the paper (papers.md 3.2 [EXT] convention).
 constexpr double DefaultThreshold = 0.5;
+
+/// The material parameters Phi of the TextureTree (papers.md 3.5, line 177): colour r, g, b,
+/// reflection rho, transmittance tau, index of refraction sigma.
+constexpr int MaterialSize = 6;
+/// The material of elements with no material node above them: light grey, opaque, sigma 1.
+constexpr double DefaultMaterial[MaterialSize] = { 0.8, 0.8, 0.8, 0.0, 0.0, 1.0 };
+/// The texture hyper-blend (line 195). As printed it does not tend to the sharp union as n grows
+/// (erratum E11: it tends to max(f_A Phi_A, f_B Phi_B) / max(f_A, f_B)); the corrected form
+/// sum f_i^n Phi_i / sum f_i^n equals the blend at n = 1 and tends to the dominant child's Phi.
+enum class TextureHyperBlend : std::uint8_t
+{
+  Corrected,
+  Verbatim
+};
 
 /// Node kinds and their values (in order). Every skeletal element starts with R (radius of
 /// influence, > 0) and i (intensity, finite); points are three values x y z.
@@ -59,6 +74,9 @@ enum class Kind : std::uint8_t
               /// node becomes the R-function, whose value inside grows by up to (2 + sqrt 2)/(2 -
               /// sqrt 2) = 5.83 per level (same surface); max keeps deep hierarchies well scaled.
   Max,
+  /// r g b rho tau sigma | one child: the material of the subtree (a texture node, papers.md
+  /// 3.5, line 165); the field is the child's. Values >= 0.
+  Material,
   // --- warps and frame nodes (one child; f_w(A)(p) = f_A(w^-1(p)), line 96) ---
   Translate, ///< t
   Rotate,    ///< axis angle (radians, right-handed, the axis non-zero)
@@ -186,6 +204,21 @@ Shape shape(const BlobTree& tree);
 /// without evaluating its distance or kernel; `kernelEvaluations`, when given, counts those that
 /// were evaluated.
 double evaluate(const BlobTree& tree, const Vec3& p, std::size_t* kernelEvaluations = nullptr);
+
+/// The TextureTree (papers.md 3.5): the material Phi(p) of the tree, as expressions of x, y, z.
+/// A material node gives its subtree's Phi; blends weight the children's Phi by their fields
+/// (line 191; the mean where every field is 0), Booleans take one child's (line 203: the union
+/// Phi_A iff f_A > f_B, the intersection iff f_A < f_B, the difference iff f_A < 2T - f_B; ties
+/// to B), the local blend mixes both (line 199), warps move it with the geometry (line 207).
+std::array<Expr, MaterialSize> material(
+  const BlobTree& tree, TextureHyperBlend mode = TextureHyperBlend::Corrected);
+/// Direct evaluation of f and Phi.
+double evaluateTextured(const BlobTree& tree, const Vec3& p, std::array<double, MaterialSize>& phi,
+  TextureHyperBlend mode = TextureHyperBlend::Corrected);
+/// shape() with Phi as attributes "colour" (r, g, b) and "optics" (rho, tau, sigma), so that the
+/// materials flow into sampled volumes, meshes and labelled tets like any attribute.
+Hypervolume texturedHypervolume(
+  const BlobTree& tree, TextureHyperBlend mode = TextureHyperBlend::Corrected);
 
 /// The axis-aligned box outside which the tree's potential is 0 (the union of its elements'
 /// boxes through the warps; a twist or scale widens conservatively). {lo, hi}.

@@ -208,6 +208,11 @@ ModelFile loadModelFile(
         bounds[2 * a] = box[0][a] - pad;
         bounds[2 * a + 1] = box[1][a] + pad;
       }
+      // Material nodes make a TextureTree: its colour and optics become the model's attributes.
+      if (tree.count(frep::blob::Kind::Material) > 0)
+      {
+        return ModelFile{ name, 0, frep::blob::texturedHypervolume(tree), bounds };
+      }
       return ModelFile{ name, 0, frep::Hypervolume(frep::blob::shape(tree).withLabel(name)),
         bounds };
     }
