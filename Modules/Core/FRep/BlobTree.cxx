@@ -360,11 +360,6 @@ struct Walker
     return out;
   }
 
-  S operator()(std::uint32_t index, const P<S>& p, bool underBlend) const
-  {
-    return value(index, p, underBlend, {}).f;
-  }
-
   Value value(std::uint32_t index, const P<S>& p, bool underBlend,
     const std::array<S, MaterialSize>& material) const
   {
@@ -1214,7 +1209,19 @@ const BlobTree& expanded(const BlobTree& tree, BlobTree& storage)
 }
 } // namespace
 
-Expr potential(const BlobTree& tree)
+namespace
+{
+template <class S>
+std::array<S, MaterialSize> defaultMaterial()
+{
+  return { S(DefaultMaterial[0]), S(DefaultMaterial[1]), S(DefaultMaterial[2]),
+    S(DefaultMaterial[3]), S(DefaultMaterial[4]), S(DefaultMaterial[5]) };
+}
+
+// The one entry to the traversal: (f, Phi) at p, complex primitives expanded first.
+template <class S>
+typename Walker<S>::Value walkTree(const BlobTree& tree, const P<S>& p, bool textured,
+  TextureHyperBlend mode, std::size_t* kernels = nullptr)
 {
   if (tree.empty())
   {
@@ -1222,8 +1229,18 @@ Expr potential(const BlobTree& tree)
   }
   BlobTree storage;
   const BlobTree& t = expanded(tree, storage);
-  const Walker<Expr> walk{ t, t.threshold(), nullptr };
-  return walk(t.root(), P<Expr>{ Expr::x(), Expr::y(), Expr::z() }, false);
+  Walker<S> walk{ t, t.threshold(), kernels };
+  walk.textured = textured;
+  walk.hyperMode = mode;
+  return walk.value(t.root(), p, false, defaultMaterial<S>());
+}
+} // namespace
+
+Expr potential(const BlobTree& tree)
+{
+  return walkTree(
+    tree, P<Expr>{ Expr::x(), Expr::y(), Expr::z() }, false, TextureHyperBlend::Corrected)
+    .f;
 }
 
 Shape shape(const BlobTree& tree)
@@ -1233,56 +1250,20 @@ Shape shape(const BlobTree& tree)
 
 double evaluate(const BlobTree& tree, const Vec3& p, std::size_t* kernelEvaluations)
 {
-  if (tree.empty())
-  {
-    throw std::invalid_argument("blobtree: the tree is empty");
-  }
-  BlobTree storage;
-  const BlobTree& t = expanded(tree, storage);
-  const Walker<double> walk{ t, t.threshold(), kernelEvaluations };
-  return walk(t.root(), P<double>{ p[0], p[1], p[2] }, false);
+  return walkTree(
+    tree, P<double>{ p[0], p[1], p[2] }, false, TextureHyperBlend::Corrected, kernelEvaluations)
+    .f;
 }
-
-namespace
-{
-template <class S>
-std::array<S, MaterialSize> defaultMaterial()
-{
-  return { S(DefaultMaterial[0]), S(DefaultMaterial[1]), S(DefaultMaterial[2]),
-    S(DefaultMaterial[3]), S(DefaultMaterial[4]), S(DefaultMaterial[5]) };
-}
-} // namespace
 
 std::array<Expr, MaterialSize> material(const BlobTree& tree, TextureHyperBlend mode)
 {
-  if (tree.empty())
-  {
-    throw std::invalid_argument("blobtree: the tree is empty");
-  }
-  BlobTree storage;
-  const BlobTree& t = expanded(tree, storage);
-  Walker<Expr> walk{ t, t.threshold(), nullptr };
-  walk.textured = true;
-  walk.hyperMode = mode;
-  return walk
-    .value(t.root(), P<Expr>{ Expr::x(), Expr::y(), Expr::z() }, false, defaultMaterial<Expr>())
-    .phi;
+  return walkTree(tree, P<Expr>{ Expr::x(), Expr::y(), Expr::z() }, true, mode).phi;
 }
 
 double evaluateTextured(const BlobTree& tree, const Vec3& p, std::array<double, MaterialSize>& phi,
   TextureHyperBlend mode)
 {
-  if (tree.empty())
-  {
-    throw std::invalid_argument("blobtree: the tree is empty");
-  }
-  BlobTree storage;
-  const BlobTree& t = expanded(tree, storage);
-  Walker<double> walk{ t, t.threshold(), nullptr };
-  walk.textured = true;
-  walk.hyperMode = mode;
-  const auto v =
-    walk.value(t.root(), P<double>{ p[0], p[1], p[2] }, false, defaultMaterial<double>());
+  const auto v = walkTree(tree, P<double>{ p[0], p[1], p[2] }, true, mode);
   phi = v.phi;
   return v.f;
 }
