@@ -20,6 +20,13 @@
 //   ct-implant            issue 15's study (Data/Studies/ct-implant/ct-implant.json): read and crop
 //                         the CT, mesh the labelled domain with CGAL at 1 mm (deterministic), the
 //                         scan's materials, the deck written; 2 threads (goal: under 3 s)
+//   trex-instantiate-2000  2,000 instances of the animated T-Rex of Data/Models/blob/trex.blob
+//                         (66 generalised cylinders, 21 frame nodes) at successive times, 1 thread
+//                         (seed 004 item 66: the paper's 2,000 in under 1 s on a Pentium 4; goal
+//                         0.1 s)
+//   trex-mesh-0.05        one instance lowered to the FRep kernel, compiled and dual-contoured at
+//                         feature size 0.05 m over its support box (no sharp features: the field
+//                         is smooth), 2 threads (item 67: the paper's 10-20 s; goal 1 s)
 //   andyhausen-100        a 10-second, 100-step run of Data/Models/icm/andyhausen.icm with the
 //                         complex discretised at every step, time-coherent (issue 5); -full: the
 //                         same run re-meshing every cell of every frame
@@ -32,6 +39,7 @@
 
 #include "Complex/Discretization.h"
 #include "Discretize/Surface.h"
+#include "FRep/BlobTree.h"
 #include "FRep/BundledModels.h"
 #include "FRep/ModelRegistry.h"
 #include "FRep/Render.h"
@@ -39,6 +47,7 @@
 #ifdef ICTK_HAVE_JIT
 #include "FRep/Jit.h"
 #endif
+#include "Lang/BlobReader.h"
 #include "Lang/ComplexFile.h"
 #include "Lang/VmReader.h"
 #include "Mesh/Writers.h"
@@ -312,6 +321,21 @@ Result Csg3(int size)
 
 // --- output -------------------------------------------------------------------------------------
 
+/// Times `mesh` (Options.Runs runs after a warm-up) into r, with the triangle count and the
+/// topology of the last mesh.
+void TimeContour(Result& r, const std::function<discretize::SurfaceMesh()>& mesh)
+{
+  discretize::SurfaceMesh last;
+  r.allSeconds = Time(
+    Options.Runs, [&] { last = mesh(); }, &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  r.work = static_cast<double>(last.triangles.size());
+  const discretize::MeshTopology t = discretize::analyzeTopology(last);
+  r.details["triangles"] = last.triangles.size();
+  r.details["manifold"] = t.manifold();
+  r.details["closed"] = t.closed();
+}
+
 Result SphereGyroid(double featureSize)
 {
   Result r;
@@ -331,19 +355,10 @@ Result SphereGyroid(double featureSize)
   discretize::SurfaceOptions options;
   options.featureSize = featureSize;
   options.threads = r.threads;
-  discretize::SurfaceMesh mesh;
-  r.allSeconds = Time(
-    Options.Runs,
+  TimeContour(r,
     [&] {
-      mesh = discretize::contourSurface(*field, { { -5, -5, -5 }, { 5, 5, 5 } }, options);
-    },
-    &r.cpuSeconds);
-  r.seconds = Median(r.allSeconds);
-  r.work = static_cast<double>(mesh.triangles.size());
-  const discretize::MeshTopology t = discretize::analyzeTopology(mesh);
-  r.details["triangles"] = mesh.triangles.size();
-  r.details["manifold"] = t.manifold();
-  r.details["closed"] = t.closed();
+      return discretize::contourSurface(*field, { { -5, -5, -5 }, { 5, 5, 5 } }, options);
+    });
   return r;
 }
 
@@ -470,6 +485,82 @@ std::optional<Result> CtImplant()
   r.details["read_seconds"] = study.readSeconds;
   r.details["mesh_seconds"] = study.meshSeconds;
   r.details["material_seconds"] = study.materialSeconds;
+  return r;
+}
+
+// --- the BlobTree T-Rex (issue 18, seed 004 items 66 and 67)
+// ---------------------------------------
+
+frep::blob::BlobTree TRex()
+{
+  return lang::readBlobFile(std::string(ICTK_DATA_DIR) + "/Models/blob/trex.blob");
+}
+
+Result TRexInstantiate(int count)
+{
+  Result r;
+  r.workload = "trex-instantiate-" + std::to_string(count);
+  r.what = "instances of the animated T-Rex (Data/Models/blob/trex.blob) at successive times";
+  r.unit = "Minstances/s";
+  if (count == 2000)
+  {
+    r.reference = "seed 004: more than 2000 in under 1 s on a Pentium 4 2.4 GHz";
+    r.referenceSeconds = 1.0;
+    r.goalSeconds = 0.1;
+  }
+  const frep::blob::BlobTree generic = TRex();
+  frep::blob::BlobTree instance;
+  r.allSeconds = Time(
+    Options.Runs,
+    [&]
+    {
+      for (int k = 0; k < count; ++k)
+      {
+        generic.instantiate(0.005 * k, instance);
+      }
+    },
+    &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  r.work = count;
+  r.details["skeletal_elements"] = instance.leafCount();
+  r.details["operators"] = instance.operatorCount();
+  r.details["frame_nodes"] = instance.count(frep::blob::Kind::Rotate);
+  r.details["generalised_cylinders"] = generic.count(frep::blob::Kind::GeneralisedCylinder);
+  return r;
+}
+
+Result TRexMesh(double featureSize)
+{
+  Result r;
+  std::ostringstream name;
+  name << "trex-mesh-" << featureSize;
+  r.workload = name.str();
+  r.what = "one T-Rex instance lowered, compiled and dual-contoured over its support box";
+  r.threads = ThreadsOr(2);
+  r.unit = "Mtriangles/s";
+  if (featureSize == 0.05)
+  {
+    r.reference = "seed 004: 10 to 20 s to polygonise an instance of a few thousand primitives";
+    r.referenceSeconds = 10.0;
+    r.goalSeconds = 1.0;
+  }
+  const frep::blob::BlobTree instance = TRex().instantiate(0.3);
+  const auto box = frep::blob::supportBox(instance);
+  discretize::SurfaceOptions options;
+  options.featureSize = featureSize;
+  options.threads = r.threads;
+  // A BlobTree is smooth by design (compact kernels, blends): vertices at the crossings' mass
+  // point, no gradients.
+  options.sharpFeatures = false;
+  TimeContour(r,
+    [&]
+    {
+      const frep::FieldPtr field =
+        frep::tapeField(frep::Tape::compile(frep::blob::shape(instance).function()));
+      return discretize::contourSurface(*field, { box[0], box[1] }, options);
+    });
+  r.details["skeletal_elements"] = instance.leafCount();
+  r.details["sharp_features"] = false;
   return r;
 }
 
@@ -623,7 +714,7 @@ CLI::App* BenchCommand::add(CLI::App& app)
 {
   CLI::App* bench = app.add_subcommand("bench",
     "Time the performance workloads (prospero rendering, csg3 sampling against VTK, sphereGyroid "
-    "meshing, the flower complex); see docs/performance.md");
+    "meshing, the flower complex, the BlobTree T-Rex); see docs/performance.md");
   AddJson(bench, Options.Json, "Print a JSON array, one object per workload");
   bench->add_option("--models", Options.Models,
     "Folder of Fidget's .vm models (default: $ICTK_BENCH_MODELS, else the build's default)");
@@ -723,6 +814,18 @@ int BenchCommand::run()
     {
       report(std::move(*r));
     }
+  }
+  const int trexCount = Options.Quick ? 200 : 2000;
+  if (Selected("trex-instantiate-" + std::to_string(trexCount)))
+  {
+    report(TRexInstantiate(trexCount));
+  }
+  const double trexSize = Options.Quick ? 0.2 : 0.05;
+  std::ostringstream trexMesh;
+  trexMesh << "trex-mesh-" << trexSize;
+  if (Selected(trexMesh.str()))
+  {
+    report(TRexMesh(trexSize));
   }
   const int andyhausenSteps = Options.Quick ? 10 : 100;
   const std::string andyhausen = "andyhausen-" + std::to_string(andyhausenSteps);

@@ -35,7 +35,7 @@ public:
   CLI::App* add(CLI::App& app) override
   {
     CLI::App* eval = app.add_subcommand("eval", "Evaluate a model at a point");
-    AddModel(eval, o.Model, "Model name (see `ictk models`) or a .hf / .xml file");
+    AddModel(eval, o.Model, "Model name (see `ictk models`) or a .hf / .xml / .vm / .blob file");
     eval->add_option("--at", o.At, "The point: x,y,z or x,y,z,t")->required();
     this->TimeOption =
       eval->add_option("--time", o.Time, "Time t (default 0), for a point given as x,y,z");

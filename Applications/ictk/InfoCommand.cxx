@@ -44,7 +44,7 @@ public:
   {
     CLI::App* info = app.add_subcommand(
       "info", "List the cells, relations and attributes of a complex (.json) or model");
-    AddModel(info, o.Model, "A .json complex or a .hf / .xml model");
+    AddModel(info, o.Model, "A .json complex or a .hf / .xml / .vm / .blob model");
     AddJson(info, o.Json, "Print a JSON object");
     return info;
   }

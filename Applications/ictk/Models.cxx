@@ -96,7 +96,7 @@ complex::Complex LoadComplex(const std::string& path)
   }
   if (!lang::isModelFile(path))
   {
-    throw UserError("'" + path + "' is not a .json complex or a .hf / .xml model");
+    throw UserError("'" + path + "' is not a .json complex or a .hf / .xml / .vm / .blob model");
   }
   const lang::ModelFile model = OpenModelFile(path);
   frep::Box3 box;

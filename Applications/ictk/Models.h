@@ -46,8 +46,8 @@ ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<doub
 bool IsComplexInput(const std::string& path);
 /// True for a complex output format (.vtpc, .vtm).
 bool IsComplexOutput(const std::string& path);
-/// A .json complex (with VTK's readers for its cells' files), or a .hf / .xml model as a complex
-/// of one 3D cell.
+/// A .json complex (with VTK's readers for its cells' files), or a .hf / .xml / .vm / .blob model
+/// as a complex of one 3D cell.
 complex::Complex LoadComplex(const std::string& path);
 
 /// The engine's errors (a .icm model that reads but does not build) in the front ends' form

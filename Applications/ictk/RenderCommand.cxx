@@ -99,7 +99,7 @@ public:
       "Draw an FRep model, a complex or a dynamic model into a PNG picture (or, with --frames, "
       "numbered PNGs or an .mp4 film), see docs/render.md");
     AddModel(render, this->Model,
-      "Model name (see `ictk models`), a .hf / .xml / .vm file, a .json complex or a .icm "
+      "Model name (see `ictk models`), a .hf / .xml / .vm / .blob file, a .json complex or a .icm "
       "dynamic model");
     AddOutput(render, this->Output,
       "Output picture (.png); with --frames a pattern (frames/%04d.png) or an .mp4 film");

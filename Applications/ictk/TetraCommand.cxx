@@ -57,7 +57,7 @@ CLI::App* TetraCommand::add(CLI::App& app)
   CLI::App* tetra = app.add_subcommand("tetra",
     "Tetrahedral mesh of a complex for FEA (.vtu, .msh, .inp, .mesh), every tetrahedron labelled "
     "by cell and material, with a quality report");
-  AddModel(tetra, o.Model, "A .json complex or a .hf / .xml model");
+  AddModel(tetra, o.Model, "A .json complex or a .hf / .xml / .vm / .blob model");
   AddOutput(tetra, o.Output, "Output: .vtu, .msh (Gmsh 4.1), .inp, .mesh");
   tetra->add_option("--backend", o.Backend, "cgal or tetgen (default: cgal when built)");
   AddSize(tetra, o.Size, "Target edge length (default: 1/32 of the complex's size)");

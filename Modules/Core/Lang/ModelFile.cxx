@@ -3,6 +3,7 @@
 // FRep XML stores them.
 #include "Lang/ModelFile.h"
 
+#include "Lang/BlobReader.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 #include "Lang/Scene.h"
@@ -36,7 +37,8 @@ enum class Format
   HyperFun,
   Xml,
   Vm,
-  Scene
+  Scene,
+  Blob
 };
 
 Format formatOf(const std::string& path)
@@ -62,6 +64,10 @@ Format formatOf(const std::string& path)
   {
     return Format::Scene;
   }
+  if (ext == ".blob")
+  {
+    return Format::Blob;
+  }
   return Format::Unknown;
 }
 
@@ -69,7 +75,7 @@ Format formatOf(const std::string& path)
 {
   throw std::invalid_argument("'" + path +
     "' is not a model file: the extension must be .hf (HyperFun), .xml (FRep XML), .scn (a "
-    "scene) or .vm (Fidget SSA, read only)");
+    "scene), .vm (Fidget SSA, read only) or .blob (BlobTree, read only)");
 }
 
 // A HyperFun body name made from any model name: letters, digits and '_', starting with a letter.
@@ -206,6 +212,37 @@ ModelFile loadModelFile(
       return ModelFile{ std::filesystem::path(path).stem().string(), 0, std::move(scene.model),
         std::nullopt };
     }
+    case Format::Blob:
+    {
+      // A static BlobTree, its field mapped to f >= 0 inside (frep::blob::shape); the bounds
+      // are its support box, where every element's field vanishes, with a 2 % margin. A model
+      // file has no time to instantiate an animated tree at, and its t = 0 instance would be
+      // a silent answer to a question about another time: refused.
+      const frep::blob::BlobTree generic = readBlobFile(path, limits);
+      if (generic.animated())
+      {
+        throw std::invalid_argument("'" + path +
+          "' is an animated BlobTree: the ictk commands read static trees only (instantiate it "
+          "at a time t with frep::blob::BlobTree::instantiate(t); docs/blobtree.md)");
+      }
+      const frep::blob::BlobTree tree = generic.instantiate(0.0);
+      std::string name = std::filesystem::path(path).stem().string();
+      const auto box = frep::blob::supportBox(tree);
+      std::array<double, 6> bounds{};
+      for (int a = 0; a < 3; ++a)
+      {
+        const double pad = 0.02 * (box[1][a] - box[0][a]);
+        bounds[2 * a] = box[0][a] - pad;
+        bounds[2 * a + 1] = box[1][a] + pad;
+      }
+      // Material nodes make a TextureTree: its colour and optics become the model's attributes.
+      if (tree.count(frep::blob::Kind::Material) > 0)
+      {
+        return ModelFile{ name, 0, frep::blob::texturedHypervolume(tree), bounds };
+      }
+      return ModelFile{ name, 0, frep::Hypervolume(frep::blob::shape(tree).withLabel(name)),
+        bounds };
+    }
     case Format::Xml:
     {
       // readFRepXmlFile's checks (readable, size) first, then the full document.
@@ -281,6 +318,10 @@ void saveModelFile(const ModelFile& model, const std::string& path)
     case Format::Scene:
       throw std::invalid_argument("cannot save '" + path +
         "': a scene is written only from a scene (saveSceneFile; `ictk convert in.scn out.scn`)");
+    case Format::Blob:
+      throw std::invalid_argument("cannot save '" + path +
+        "': .blob files are read only (a BlobTree is written by hand or generated; see "
+        "docs/blobtree.md)");
     default:
       unknownExtension(path);
   }

@@ -2,7 +2,8 @@
 #pragma once
 // Opening and saving model files by extension: .hf (HyperFun) and .xml (FRep XML); .scn and
 // .scene (seed 003's scenes, Lang/Scene.h) are read, and written only from a scene
-// (saveSceneFile); .vm (Fidget's SSA benchmark format, negated on import) is read only.
+// (saveSceneFile); .vm (Fidget's SSA benchmark format, negated on import) and .blob (a BlobTree,
+// mapped to f >= 0 inside by frep::blob::shape) are read only.
 
 #include "FRep/Hypervolume.h"
 #include "Lang/Diagnostics.h"
@@ -24,7 +25,7 @@ struct ModelFile
   std::optional<std::array<double, 6>> bounds;
 };
 
-/// True for paths ending in .hf, .xml, .scn, .scene or .vm (case-insensitive).
+/// True for paths ending in .hf, .xml, .scn, .scene, .vm or .blob (case-insensitive).
 bool isModelFile(const std::string& path);
 /// True for paths ending in .scn or .scene (case-insensitive): seed 003's scenes (Lang/Scene.h).
 bool isSceneFile(const std::string& path);

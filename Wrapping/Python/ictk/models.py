@@ -314,17 +314,17 @@ def _time_steps_key():
 
 
 def _is_model_file(source):
-    return os.path.splitext(source)[1].lower() in (".hf", ".xml", ".vm")
+    return os.path.splitext(source)[1].lower() in (".hf", ".xml", ".vm", ".blob")
 
 
 def load(path, **options):
-    """A Model (.hf, .xml, .vm or a registered model's name), a Complex (.json) or a
+    """A Model (.hf, .xml, .vm, .blob or a registered model's name), a Complex (.json) or a
     DynamicModel (.icm), by the file's extension."""
     ext = os.path.splitext(str(path))[1].lower()
     if ext == ".json":
         return Complex(path, **options)
     if ext == ".icm":
         return DynamicModel(path, **options)
-    if ext and ext not in (".hf", ".xml", ".vm"):
-        raise Error(f"'{path}' is not a model file ICTK reads (.hf, .xml, .vm, .json, .icm)")
+    if ext and ext not in (".hf", ".xml", ".vm", ".blob"):
+        raise Error(f"'{path}' is not a model file ICTK reads (.hf, .xml, .vm, .blob, .json, .icm)")
     return Model(path, **options)

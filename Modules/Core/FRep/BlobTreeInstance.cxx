@@ -1,0 +1,321 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The BlobTree through time (papers.md 3.6): the evolution functions of animated values, and the
+// instantiation of a generic tree at t, which evaluates them and expands the complex primitives
+// (generalised cylinders, papers.md 3.4) into skeletal elements. Kept apart from BlobTree.cxx (the
+// tree, its evaluation and its lowering) because instantiation is the part that must be fast
+// (item 66) and reuses an instance's layout.
+#include "FRep/BlobTree.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace ictk::frep::blob
+{
+
+namespace
+{
+constexpr double pi = 3.14159265358979323846;
+
+// Catmull-Rom through the control points (x, y, z, r), uniform parameter u in [0, count - 1]:
+// the tangent at a control point is half the difference of its neighbours, one-sided at the ends.
+// Written as p0 + h01 (p1 - p0) + h10 m0 + h11 m1 so that a constant radius stays bit-exact (the
+// leaf rules of papers.md 3.4 compare radii exactly). `tangents` receives 4 count values.
+void curveTangents(const double* ctrl, std::uint32_t count, double* tangents)
+{
+  for (std::uint32_t i = 0; i < count; ++i)
+  {
+    const double* before = ctrl + 4 * (i == 0 ? 0 : i - 1);
+    const double* after = ctrl + 4 * (i + 1 == count ? i : i + 1);
+    const double f = (i == 0 || i + 1 == count) ? 1.0 : 0.5;
+    for (int k = 0; k < 4; ++k)
+    {
+      tangents[4 * i + k] = f * (after[k] - before[k]);
+    }
+  }
+}
+
+std::array<double, 4> curvePoint(
+  const double* ctrl, const double* tangents, std::uint32_t count, double u)
+{
+  const std::uint32_t i = std::min(static_cast<std::uint32_t>(u), count - 2);
+  const double s = u - static_cast<double>(i);
+  const double h01 = s * s * (3 - 2 * s);
+  const double h10 = s * (1 - s) * (1 - s);
+  const double h11 = s * s * (s - 1);
+  const double* p0 = ctrl + 4 * i;
+  const double* m0 = tangents + 4 * i;
+  std::array<double, 4> out{};
+  for (int k = 0; k < 4; ++k)
+  {
+    out[k] = p0[k] + h01 * (p0[4 + k] - p0[k]) + h10 * m0[k] + h11 * m0[4 + k];
+  }
+  out[3] = std::max(out[3], 0.0);
+  return out;
+}
+
+} // namespace
+
+double Animation::eval(double t) const
+{
+  if (type == Type::Wave)
+  {
+    return base + amplitude * std::sin(2 * pi * t / period + phase);
+  }
+  if (keys.size() == 1 || t <= keys.front()[0])
+  {
+    return keys.front()[1];
+  }
+  if (t >= keys.back()[0])
+  {
+    return keys.back()[1];
+  }
+  std::size_t k = 0;
+  while (keys[k + 1][0] <= t)
+  {
+    ++k;
+  }
+  // P(s) = sum c_j s^j on s = (t - t_k) / h, derivatives scaled by h^j: the first n coefficients
+  // come from the left key, the last n from the right key's conditions (an n x n solve).
+  const int n = order;
+  const double h = keys[k + 1][0] - keys[k][0];
+  std::vector<double> c(2 * n, 0.0);
+  double hj = 1, fact = 1;
+  for (int j = 0; j < n; ++j)
+  {
+    c[j] = keys[k][1 + j] * hj / fact;
+    hj *= h;
+    fact *= (j + 1);
+  }
+  // Row j: sum_{m >= n} c_m m!/(m-j)! = v1_j h^j - sum_{m < n} c_m m!/(m-j)!.
+  std::vector<double> A(n * n), rhs(n);
+  hj = 1;
+  for (int j = 0; j < n; ++j)
+  {
+    auto falling = [](int m, int j2)
+    {
+      double f = 1;
+      for (int q = 0; q < j2; ++q)
+      {
+        f *= (m - q);
+      }
+      return f;
+    };
+    double r = keys[k + 1][1 + j] * hj;
+    for (int m = 0; m < n; ++m)
+    {
+      r -= c[m] * (m >= j ? falling(m, j) : 0.0);
+    }
+    for (int m = n; m < 2 * n; ++m)
+    {
+      A[j * n + (m - n)] = falling(m, j);
+    }
+    rhs[j] = r;
+    hj *= h;
+  }
+  for (int col = 0; col < n; ++col) // Gaussian elimination with partial pivoting
+  {
+    int piv = col;
+    for (int r = col + 1; r < n; ++r)
+    {
+      if (std::fabs(A[r * n + col]) > std::fabs(A[piv * n + col]))
+      {
+        piv = r;
+      }
+    }
+    for (int q = 0; q < n; ++q)
+    {
+      std::swap(A[col * n + q], A[piv * n + q]);
+    }
+    std::swap(rhs[col], rhs[piv]);
+    for (int r = col + 1; r < n; ++r)
+    {
+      const double f = A[r * n + col] / A[col * n + col];
+      for (int q = col; q < n; ++q)
+      {
+        A[r * n + q] -= f * A[col * n + q];
+      }
+      rhs[r] -= f * rhs[col];
+    }
+  }
+  for (int r = n - 1; r >= 0; --r)
+  {
+    double v = rhs[r];
+    for (int q = r + 1; q < n; ++q)
+    {
+      v -= A[r * n + q] * c[n + q];
+    }
+    c[n + r] = v / A[r * n + r];
+  }
+  const double s = (t - keys[k][0]) / h;
+  double value = 0;
+  for (int j = 2 * n - 1; j >= 0; --j)
+  {
+    value = value * s + c[j];
+  }
+  return value;
+}
+
+namespace
+{
+// Every change to a tree's structure takes a new number, so that an instance knows whether it
+// was laid out from the structure it is asked to hold again.
+std::atomic<std::uint64_t> structures{ 0 };
+
+// A generalised cylinder's element between two samples (x, y, z, r): its kind by the rule of
+// papers.md 3.4 and its values, written into a slot of 10.
+Kind cylinderPiece(const double* nv, const std::array<double, 4>& a, const std::array<double, 4>& b,
+  double* out, std::uint32_t& count)
+{
+  out[0] = nv[0];
+  out[1] = nv[1];
+  out[2] = a[0];
+  out[3] = a[1];
+  out[4] = a[2];
+  out[5] = b[0];
+  out[6] = b[1];
+  out[7] = b[2];
+  if (a[3] != b[3])
+  {
+    out[8] = a[3];
+    out[9] = b[3];
+    count = 10;
+    return Kind::ConeSphere;
+  }
+  out[8] = b[3];
+  count = b[3] == 0 ? 8 : 9;
+  return b[3] == 0 ? Kind::Segment : Kind::Cylinder;
+}
+} // namespace
+
+void BlobTree::touch()
+{
+  structure_ = ++structures;
+  instanceOf_ = 0;
+}
+
+void BlobTree::instantiate(double t, BlobTree& out) const
+{
+  double threshold = threshold_;
+  if (!thresholdAnimation_.empty())
+  {
+    const double T = thresholdAnimation_[0].eval(t);
+    threshold = T > 0 && std::isfinite(T) ? T : threshold_;
+  }
+  // The instance keeps its layout when it was made from this structure: only values change.
+  const bool relayout = out.instanceOf_ == 0 || out.instanceOf_ != structure_;
+  if (relayout)
+  {
+    out.clear();
+  }
+  out.threshold_ = threshold;
+  if (nodes_.empty())
+  {
+    return;
+  }
+  // The values at t (parameters P_A(t)), then the nodes in order, complex ones expanded.
+  std::vector<double>& v = out.scratch_;
+  v.assign(values_.begin(), values_.end());
+  for (const Animated& a : animations_)
+  {
+    v[a.value] = a.animation.eval(t);
+  }
+  std::vector<std::uint32_t>& map = out.map_;
+  if (relayout)
+  {
+    map.assign(nodes_.size(), 0);
+    out.pieces_.clear();
+  }
+  auto push = [&out](Kind kind, const double* values, std::uint32_t count, std::uint32_t slot,
+                const std::uint32_t* children, std::uint32_t childCount)
+  {
+    out.nodes_.push_back({ kind, static_cast<std::uint32_t>(out.values_.size()), count,
+      static_cast<std::uint32_t>(out.links_.size()), childCount });
+    out.values_.insert(out.values_.end(), values, values + slot);
+    out.links_.insert(out.links_.end(), children, children + childCount);
+    return static_cast<std::uint32_t>(out.nodes_.size() - 1);
+  };
+  std::vector<std::uint32_t> level, next;
+  std::size_t piece = 0;
+  for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+  {
+    const Node& n = nodes_[i];
+    const double* nv = v.data() + n.firstValue;
+    if (n.kind != Kind::GeneralisedCylinder)
+    {
+      if (!relayout)
+      {
+        std::copy(nv, nv + n.valueCount, out.values_.data() + out.nodes_[map[i]].firstValue);
+        continue;
+      }
+      map[i] = push(n.kind, nv, n.valueCount, n.valueCount, nullptr, 0);
+      for (std::uint32_t k = 0; k < n.childCount; ++k)
+      {
+        out.links_.push_back(map[links_[n.firstChild + k]]);
+      }
+      out.nodes_.back().childCount = n.childCount;
+      continue;
+    }
+    // Generalised cylinder (papers.md 3.4, lines 118-125): n segments of the sampled curve, a
+    // cone-sphere where the end radii differ, a line-swept sphere where they are equal, a
+    // segment where both are null, under a balanced tree of binary unions (max: Kind::Max). Each
+    // element has a slot of 10 values, so that a kind changing with t keeps the layout.
+    const auto segments = static_cast<std::uint32_t>(nv[2]);
+    const std::uint32_t controls = (n.valueCount - 3) / 4;
+    std::vector<double>& tangents = out.tangents_;
+    tangents.resize(4 * controls);
+    curveTangents(nv + 3, controls, tangents.data());
+    std::array<double, 4> prev = curvePoint(nv + 3, tangents.data(), controls, 0.0);
+    level.clear();
+    for (std::uint32_t s = 1; s <= segments; ++s)
+    {
+      const std::array<double, 4> cur = curvePoint(nv + 3, tangents.data(), controls,
+        static_cast<double>(controls - 1) * s / static_cast<double>(segments));
+      double pieceValues[10];
+      std::uint32_t count = 0;
+      const Kind kind = cylinderPiece(nv, prev, cur, pieceValues, count);
+      if (relayout)
+      {
+        level.push_back(push(kind, pieceValues, count, 10, nullptr, 0));
+        out.pieces_.push_back(level.back());
+      }
+      else
+      {
+        Node& leaf = out.nodes_[out.pieces_[piece++]];
+        leaf.kind = kind;
+        leaf.valueCount = count;
+        std::copy(pieceValues, pieceValues + 10, out.values_.data() + leaf.firstValue);
+      }
+      prev = cur;
+    }
+    if (!relayout)
+    {
+      continue;
+    }
+    while (level.size() > 1)
+    {
+      next.clear();
+      for (std::size_t k = 0; k + 1 < level.size(); k += 2)
+      {
+        next.push_back(push(Kind::Max, nullptr, 0, 0, &level[k], 2));
+      }
+      if (level.size() % 2)
+      {
+        next.push_back(level.back());
+      }
+      level.swap(next);
+    }
+    map[i] = level[0];
+  }
+  out.root_ = map[root_];
+  out.instanceOf_ = structure_;
+}
+
+BlobTree BlobTree::instantiate(double t) const
+{
+  BlobTree out;
+  instantiate(t, out);
+  return out;
+}
+
+} // namespace ictk::frep::blob
