@@ -170,6 +170,12 @@ frep::TapePtr ProsperoTape(std::string& whyNot)
 constexpr double kBruteGoalSeconds = 0.044;
 constexpr double kPrunedGoalSeconds = 0.006;
 
+/// Tiles of the pruned render with the JIT, chosen by measured cost (docs/performance.md, issue
+/// 20): a leaf's pruned tape costs ~30 us to simplify and compile whatever its size, and the
+/// compiled code evaluates a pixel in nanoseconds, so fewer, larger leaves win (128/32: 45 ms CPU
+/// on one thread, 256/64: 29 ms, 256/128: 25 ms). The interpreter keeps RenderOptions' default.
+const std::vector<int> kJitTileSizes{ 256, 128 };
+
 frep::RenderOptions ProsperoOptions(bool prune, bool jit, int threads)
 {
   frep::RenderOptions options;
@@ -177,6 +183,7 @@ frep::RenderOptions ProsperoOptions(bool prune, bool jit, int threads)
   if (jit) // the same render with pixels evaluated by the JIT (FRep/Jit.h)
   {
     options.rowEvaluator = frep::jitRowEvaluatorFactory();
+    options.tileSizes = kJitTileSizes;
   }
 #else
   (void)jit;
@@ -201,7 +208,8 @@ Result Prospero(const frep::TapePtr& tape, bool prune, int size, bool jit = fals
   Result r;
   r.workload = std::string("prospero-") + (prune ? "pruned-" : "brute-") + std::to_string(size) +
     (jit ? "-jit" : "");
-  r.what = prune ? "sign of prospero.vm, recursive interval subdivision (tiles 128, 32), float"
+  r.what = prune ? std::string("sign of prospero.vm, recursive interval subdivision (tiles ") +
+      (jit ? "256, 128" : "128, 32") + "), float"
                  : "sign of prospero.vm, every pixel with the full tape, float";
   r.threads = ThreadsOr(prune ? 2 : 1);
   r.work = static_cast<double>(size) * size;
@@ -610,15 +618,6 @@ nlohmann::json SurfaceDistance(
   return j;
 }
 
-std::string Fixed(double value, int digits)
-{
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << value;
-  return s.str();
-}
-
 /// Issue 20's goals against libfive: pruned prospero 6x its Heightmap and 3x its recursion without
 /// normals; sphereGyroid 12x at a triangle count within 10 % of libfive's.
 constexpr double kHeightmapGoalRatio = 6.0;
@@ -709,7 +708,9 @@ std::vector<PeerCase> PeerCases(const std::string& l5bench, bool quick)
   }
 
   const double featureSize = quick ? 0.1 : 0.025;
-  const std::string gyroid = "sphere-gyroid-" + Fixed(featureSize, featureSize < 0.1 ? 3 : 1);
+  std::ostringstream sizeText; // as SphereGyroid names it: 0.025, 0.1
+  sizeText << featureSize;
+  const std::string gyroid = "sphere-gyroid-" + sizeText.str();
   if (Selected(gyroid))
   {
     PeerCase c;
@@ -738,7 +739,7 @@ std::vector<PeerCase> PeerCases(const std::string& l5bench, bool quick)
       PeerSide side = InProcessSide(
         "ICTK",
         matched ? "dual contouring, libfive's triangle count"
-                : "dual contouring, feature size " + Fixed(featureSize, 3),
+                : "dual contouring, feature size " + sizeText.str(),
         1,
         [=]
         {

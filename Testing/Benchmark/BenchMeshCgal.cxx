@@ -16,6 +16,7 @@
 //   ictkBenchMeshCgal --benchmark_filter=0.1/           (any Google Benchmark flag)
 #include "Lang/ComplexFile.h"
 #include "Mesh/CGAL/MeshCgal.h"
+#include "MeshTestModels.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Labeled_mesh_domain_3.h>
@@ -103,20 +104,10 @@ void report(benchmark::State& state, const std::vector<Point3>& points,
   state.counters["meanEdge"] = tets.empty() ? 0 : sum / (6.0 * static_cast<double>(tets.size()));
 }
 
-const char* kSphereInBox = R"({
-  "cells": [
-    { "name": "box", "kind": "F", "dimension": 3,
-      "inside": ["x[1] + 1", "1 - x[1]", "x[2] + 1", "1 - x[2]", "x[3] + 1", "1 - x[3]"],
-      "bounds": [[-1.05, -1.05, -1.05], [1.05, 1.05, 1.05]] },
-    { "name": "sphere", "kind": "F", "dimension": 3, "priority": 1,
-      "inside": ["0.25 - x[1]^2 - x[2]^2 - x[3]^2"],
-      "bounds": [[-0.55, -0.55, -0.55], [0.55, 0.55, 0.55]] }
-  ]
-})";
-
 void ictkBackend(benchmark::State& state, double size, bool deterministic, int threads = 1)
 {
-  const complex::Complex k = lang::readComplexJson(kSphereInBox, "sphere-in-box.json");
+  const complex::Complex k =
+    lang::readComplexJson(ictk::testing::sphereInBoxJson(), "sphere-in-box.json");
   mesh::TetraOptions o;
   o.size = size;
   o.deterministic = deterministic;

@@ -101,17 +101,8 @@ TEST(MeshCgal, DeterministicModeIsReproducible)
 // deterministic mode stays sequential (its output is unchanged byte for byte; the tests above).
 TEST(MeshCgal, ParallelRefinementKeepsVolumesAndQuality)
 {
-  const complex::Complex k = lang::readComplexJson(R"({
-  "cells": [
-    { "name": "box", "kind": "F", "dimension": 3,
-      "inside": ["x[1] + 1", "1 - x[1]", "x[2] + 1", "1 - x[2]", "x[3] + 1", "1 - x[3]"],
-      "bounds": [[-1.05, -1.05, -1.05], [1.05, 1.05, 1.05]] },
-    { "name": "sphere", "kind": "F", "dimension": 3, "priority": 1,
-      "inside": ["0.25 - x[1]^2 - x[2]^2 - x[3]^2"],
-      "bounds": [[-0.55, -0.55, -0.55], [0.55, 0.55, 0.55]] }
-  ]
-})",
-    "sphere-in-box.json");
+  const complex::Complex k =
+    lang::readComplexJson(ictk::testing::sphereInBoxJson(), "sphere-in-box.json");
   mesh::TetraOptions o;
   o.size = 0.1;
   o.threads = 1;

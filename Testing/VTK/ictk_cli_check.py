@@ -536,7 +536,7 @@ def check_bench_peer(ictk, work):
                 sys.exit(f"FAIL: {c['workload']}: libfive details {libfive}")
     g = {s["label"]: s for s in cases["sphere-gyroid-0.1"]["sides"]}
     matched = g["dual contouring, libfive's triangle count"]["details"]
-    plain = g["dual contouring, feature size 0.100"]["details"]
+    plain = g["dual contouring, feature size 0.1"]["details"]
     if not abs(matched["triangles"] / 20000 - 1) <= 0.1 or plain["feature_size"] != 0.1:
         sys.exit(f"FAIL: matched sphereGyroid: {matched} (plain {plain})")
     near(matched["triangles_over_libfive"], matched["triangles"] / 20000, 1e-12, "triangles_over_libfive")

@@ -30,8 +30,9 @@ namespace ictk::mesh
 /// `size` (so estimateTetrahedra predicts the count) and protected curves get edges of at most
 /// `size`. In the default mode on more than one thread (options.threads, 0: every core),
 /// refinement, perturbation and exudation run on CGAL's parallel code (Parallel_tag, TBB; see
-/// cgalMeshesInParallel); the deterministic mode is always sequential. Sliver exudation (deterministic: no random choice, no time limit) aims at
-/// options.minDihedralDegrees in both modes; the default mode perturbs vertices first (random).
+/// cgalMeshesInParallel); the deterministic mode is always sequential. Sliver exudation
+/// (deterministic: no random choice, no time limit) aims at options.minDihedralDegrees in both
+/// modes; the default mode perturbs vertices first (random).
 /// options.deterministic: no perturbation and fixed seeds, identical output run to run and
 /// thread count to thread count (the flower: min dihedral 6.3 deg instead of 0.3 without
 /// exudation, 9.5 deg with perturbation).
