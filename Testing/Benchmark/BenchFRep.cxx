@@ -11,6 +11,9 @@
 #include "FRep/BundledModels.h"
 #include "FRep/ModelRegistry.h"
 #include "FRep/Render.h"
+#ifdef ICTK_HAVE_JIT
+#include "FRep/Jit.h"
+#endif
 #include "FRep/Sampling.h"
 #include "Lang/VmReader.h"
 
@@ -202,6 +205,60 @@ void registerPerformanceWorkloads(bool quick)
         })
         ->UseRealTime()
         ->Unit(benchmark::kMillisecond);
+    }
+    // Tile sizes of the pruned render by measured cost (issue 20), 1 thread, the interpreter and
+    // the JIT: ictk/prospero-pruned-tiles/<sizes>/<interpreter|jit>, with the leaves and their
+    // mean tape length as counters.
+    const std::vector<std::vector<int>> tilings{ { 128, 32 }, { 256, 64 }, { 256, 128 },
+      { 128, 64 }, { 64, 16 }, { 256, 64, 16 }, { 128, 32, 8 } };
+    for (const auto& tiles : tilings)
+    {
+      for (const bool jit : { false, true })
+      {
+#ifdef ICTK_HAVE_JIT
+        if (jit && !ictk::frep::JitEvaluator::available())
+        {
+          continue;
+        }
+#else
+        if (jit)
+        {
+          continue;
+        }
+#endif
+        std::string name = "ictk/prospero-pruned-tiles/";
+        for (std::size_t i = 0; i < tiles.size(); ++i)
+        {
+          name += (i ? "," : "") + std::to_string(tiles[i]);
+        }
+        name += jit ? "/jit" : "/interpreter";
+        benchmark::RegisterBenchmark(name.c_str(),
+          [tape, tiles, jit](benchmark::State& state)
+          {
+            RenderOptions options;
+            options.threads = 1;
+            options.tileSizes = tiles;
+#ifdef ICTK_HAVE_JIT
+            if (jit)
+            {
+              options.rowEvaluator = ictk::frep::jitRowEvaluatorFactory();
+            }
+#endif
+            for (auto _ : state)
+            {
+              benchmark::DoNotOptimize(renderSign2D(tape, RenderRegion{}, 1024, 1024, options));
+            }
+            RenderStats stats;
+            options.stats = &stats;
+            renderSign2D(tape, RenderRegion{}, 1024, 1024, options);
+            state.counters["leaves"] = static_cast<double>(stats.tilesEvaluated);
+            state.counters["leafTape"] = stats.tilesEvaluated
+              ? static_cast<double>(stats.leafInstructions) /
+                static_cast<double>(stats.tilesEvaluated)
+              : 0.0;
+          })
+          ->Unit(benchmark::kMillisecond);
+      }
     }
   }
   else

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The CGAL Mesh_3 backend (Mesh/CGAL/MeshCgal.h) against plain CGAL Mesh_3 on the same implicit
 // model: a sphere of radius 0.5 (priority 1) inside the box [-1, 1]^3 (priority 0), two materials,
-// at sizes 0.1, 0.05 and 0.025, deterministic (no perturb / exude) and default (perturb + exude).
+// at sizes 0.1, 0.05 and 0.025, deterministic (no perturb / exude) and default (perturb + exude);
+// the backend's default mode also on 2 threads (CGAL's Parallel_tag, issue 20) against plain
+// sequential CGAL.
 //
 // "Plain CGAL" is what a CGAL user would write: a labelled domain whose label function is a C++
 // lambda, the box's 12 edges given as 2-point polylines, and the same criteria, error bound and
@@ -22,6 +24,7 @@
 //   ictkBenchMeshCgal --benchmark_filter=0.1/           (any Google Benchmark flag)
 #include "Lang/ComplexFile.h"
 #include "Mesh/CGAL/MeshCgal.h"
+#include "MeshTestModels.h"
 #include "Voxel/VolumeFile.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -111,23 +114,14 @@ void report(benchmark::State& state, const std::vector<Point3>& points,
   state.counters["meanEdge"] = tets.empty() ? 0 : sum / (6.0 * static_cast<double>(tets.size()));
 }
 
-const char* kSphereInBox = R"({
-  "cells": [
-    { "name": "box", "kind": "F", "dimension": 3,
-      "inside": ["x[1] + 1", "1 - x[1]", "x[2] + 1", "1 - x[2]", "x[3] + 1", "1 - x[3]"],
-      "bounds": [[-1.05, -1.05, -1.05], [1.05, 1.05, 1.05]] },
-    { "name": "sphere", "kind": "F", "dimension": 3, "priority": 1,
-      "inside": ["0.25 - x[1]^2 - x[2]^2 - x[3]^2"],
-      "bounds": [[-0.55, -0.55, -0.55], [0.55, 0.55, 0.55]] }
-  ]
-})";
-
-void ictkBackend(benchmark::State& state, double size, bool deterministic)
+void ictkBackend(benchmark::State& state, double size, bool deterministic, int threads = 1)
 {
-  const complex::Complex k = lang::readComplexJson(kSphereInBox, "sphere-in-box.json");
+  const complex::Complex k =
+    lang::readComplexJson(ictk::testing::sphereInBoxJson(), "sphere-in-box.json");
   mesh::TetraOptions o;
   o.size = size;
   o.deterministic = deterministic;
+  o.threads = threads; // the default mode on 2 threads is CGAL's Parallel_tag
   mesh::TetMesh m;
   for (auto _ : state)
   {
@@ -376,6 +370,10 @@ BENCHMARK_CAPTURE(plainCgal, 0.1_default, 0.1, false)
   ->Unit(benchmark::kMillisecond)
   ->UseRealTime()
   ->Iterations(1);
+BENCHMARK_CAPTURE(ictkBackend, 0.1_default_2threads, 0.1, false, 2)
+  ->Unit(benchmark::kMillisecond)
+  ->UseRealTime()
+  ->Iterations(1);
 BENCHMARK_CAPTURE(ictkBackend, 0.05_deterministic, 0.05, true)
   ->Unit(benchmark::kMillisecond)
   ->UseRealTime()
@@ -389,6 +387,10 @@ BENCHMARK_CAPTURE(ictkBackend, 0.05_default, 0.05, false)
   ->UseRealTime()
   ->Iterations(1);
 BENCHMARK_CAPTURE(plainCgal, 0.05_default, 0.05, false)
+  ->Unit(benchmark::kMillisecond)
+  ->UseRealTime()
+  ->Iterations(1);
+BENCHMARK_CAPTURE(ictkBackend, 0.05_default_2threads, 0.05, false, 2)
   ->Unit(benchmark::kMillisecond)
   ->UseRealTime()
   ->Iterations(1);
@@ -410,4 +412,8 @@ BENCHMARK_CAPTURE(plainCgal, 0.025_default, 0.025, false)
   ->Iterations(1);
 BENCHMARK(ctImplant)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK(plainCgalCt)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(ictkBackend, 0.025_default_2threads, 0.025, false, 2)
+  ->Unit(benchmark::kMillisecond)
+  ->UseRealTime()
+  ->Iterations(1);
 BENCHMARK_MAIN();

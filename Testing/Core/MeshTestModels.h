@@ -2,7 +2,7 @@
 #pragma once
 // Two-material bars for the mesh tests (issue 6): [0,1]x[0,0.2]^2 and [1,2]x[0,0.2]^2 as a
 // complex read from JSON, meshed by the Kuhn split of a box grid and labelled by centroids; the
-// area of the faces a mesh has on a plane (internal surfaces).
+// area of the faces a mesh has on a plane (internal surfaces); a sphere in a box.
 
 #include "Lang/ComplexFile.h"
 #include "Mesh/Structured.h"
@@ -16,6 +16,22 @@
 
 namespace ictk::testing
 {
+
+/// A sphere of radius 0.5 (priority 1) inside the box [-1, 1]^3: two materials, the CGAL
+/// backend's benchmark (ictkBenchMeshCgal) and its parallel test.
+inline const char* sphereInBoxJson()
+{
+  return R"({
+  "cells": [
+    { "name": "box", "kind": "F", "dimension": 3,
+      "inside": ["x[1] + 1", "1 - x[1]", "x[2] + 1", "1 - x[2]", "x[3] + 1", "1 - x[3]"],
+      "bounds": [[-1.05, -1.05, -1.05], [1.05, 1.05, 1.05]] },
+    { "name": "sphere", "kind": "F", "dimension": 3, "priority": 1,
+      "inside": ["0.25 - x[1]^2 - x[2]^2 - x[3]^2"],
+      "bounds": [[-0.55, -0.55, -0.55], [0.55, 0.55, 0.55]] }
+  ]
+})";
+}
 
 /// The solver check's bar: E = 210000 | 70000, nu = 0 (springs in series are then exact) unless
 /// `poisson` says otherwise.

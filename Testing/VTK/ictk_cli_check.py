@@ -4,7 +4,7 @@
 
 Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d | bench
-  | bench-scaling | render
+  | bench-scaling | bench-peer | render
   run-disk DATA | run-errors DATA   (ictk run on the .icm models in DATA/Models/icm)
   tetra-bar DATA | solve-bar DATA   (ictk tetra and ictk solve on DATA/Models/bar)
   study DATA   (ictk study on DATA/Studies/ct-implant and its bad inputs; needs invesalius-examples)
@@ -458,6 +458,117 @@ def check_bench(ictk, work):
     p = run(ictk, ["bench", "--only", "nothing-like-this"], check=False)
     if p.returncode != 2 or "ictk: error: --only" not in p.stderr:
         sys.exit(f"FAIL: --only without a match: exit {p.returncode}\n{p.stderr}")
+
+
+# A stand-in for libfive's l5bench (../shared/bench/peers/libfive): the same command line and JSON
+# lines, with times known in advance. Round k of a command reports BASE[command] * (1, 3, 2)[k % 3]
+# seconds, so three rounds have the median 2 * BASE.
+FAKE_L5BENCH = """#!/usr/bin/python3
+import json, os, sys
+BASE = {"brute": 0.5, "pruned": 0.125, "signonly": 0.0625, "gyroid": 2.0}
+cmd = sys.argv[1]
+if os.environ.get("FAKE_L5BENCH_FAIL") == cmd:
+    sys.exit(3)
+state = os.path.join(os.path.dirname(os.path.abspath(__file__)), cmd + ".calls")
+calls = int(open(state).read()) if os.path.exists(state) else 0
+open(state, "w").write(str(calls + 1))
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "args.log"), "a") as log:
+    log.write(" ".join(sys.argv[1:]) + "\\n")
+s = BASE[cmd] * (1, 3, 2)[calls % 3]
+print("libfive banner, not JSON")
+print(json.dumps({"workload": cmd, "seconds": s, "cpu_seconds": s / 2, "all_seconds": [s]}))
+if cmd == "gyroid":
+    print(json.dumps({"workload": "mesh", "triangles": 20000, "vertices": 10000}))
+else:
+    print(json.dumps({"inside_pixels": 1234}))
+"""
+
+
+def check_bench_peer(ictk, work):
+    # `ictk bench --peer-libfive` (BenchPeer.h) against the stand-in above: what it reports for
+    # libfive's side is the median of the stand-in's rounds, each ratio the quotient of the two
+    # sides' medians, and the matched sphereGyroid side meshes within 10 % of libfive's triangles.
+    fake = os.path.join(work, "l5bench")
+    with open(fake, "w") as f:
+        f.write(FAKE_L5BENCH)
+    os.chmod(fake, 0o755)
+    models = os.path.join(work, "models")
+    os.makedirs(models)
+    with open(os.path.join(models, "prospero.vm"), "w") as f:  # a disc of radius 0.5, Fidget's SSA
+        f.write("_0 var-x\n_1 var-y\n_2 square _0\n_3 square _1\n_4 add _2 _3\n_5 sqrt _4\n"
+                "_6 const 0.5\n_7 sub _5 _6\n")
+    d = json.loads(run(ictk, ["bench", "--quick", "--json", "--rounds", "3", "--models", models,
+                              "--peer-libfive", fake]).stdout)
+    if d["rounds"] != 3 or d["peer_libfive"] != fake:
+        sys.exit(f"FAIL: peer header: {d}")
+    cases = {c["workload"]: c for c in d["cases"]}
+    if sorted(cases) != ["csg3-64", "prospero-brute-128", "prospero-pruned-128", "sphere-gyroid-0.1"]:
+        sys.exit(f"FAIL: peer workloads: {sorted(cases)}")
+    base = {"ArrayEvaluator": 0.5, "Heightmap (with normals)": 0.125,
+            "Heightmap's recursion, no normals": 0.0625, "Mesh::render, min_feature 0.025": 2.0}
+    for c in d["cases"]:
+        sides = {s["tool"] + " " + s["label"]: s for s in c["sides"]}
+        for s in c["sides"]:
+            if len(s["round_seconds"]) != 3:
+                sys.exit(f"FAIL: {c['workload']} {s['label']}: not 3 rounds: {s}")
+            near(s["seconds"], sorted(s["round_seconds"])[1], 0, f"{s['label']}: median of rounds")
+            if s["tool"] == "libfive":
+                b = base[s["label"]]
+                if sorted(s["round_seconds"]) != [b, 2 * b, 3 * b]:
+                    sys.exit(f"FAIL: {s['label']}: rounds {s['round_seconds']}")
+                near(s["seconds"], 2 * b, 0, f"{s['label']} median")
+                near(s["cpu_seconds"], b, 0, f"{s['label']} CPU median")
+        for r in c["ratios"]:
+            ictk_side = sides["ICTK " + r["ictk"]]
+            peer = sides[r["peer"]]
+            near(r["ratio"], peer["seconds"] / ictk_side["seconds"], 1e-12 * r["ratio"],
+                 f"{c['workload']} ratio {r['peer']} / {r['ictk']}")
+            for k in range(3):
+                near(r["round_ratios"][k], peer["round_seconds"][k] / ictk_side["round_seconds"][k],
+                     1e-12 * r["round_ratios"][k], "round ratio")
+        if c["workload"].startswith("prospero"):
+            ictk_inside = [s["details"]["inside_pixels"] for s in c["sides"] if s["tool"] == "ICTK"]
+            # The disc of radius 0.5 covers pi / 16 of [-1, 1]^2: 3217 of 128^2 pixels, about.
+            if not ictk_inside or any(abs(n - math.pi / 16 * 128 * 128) > 100 for n in ictk_inside):
+                sys.exit(f"FAIL: {c['workload']}: ICTK inside pixels {ictk_inside}")
+            libfive = [s for s in c["sides"] if s["tool"] == "libfive"]
+            if any(s["details"].get("inside_pixels") != 1234 for s in libfive):
+                sys.exit(f"FAIL: {c['workload']}: libfive details {libfive}")
+    g = {s["label"]: s for s in cases["sphere-gyroid-0.1"]["sides"]}
+    matched = g["dual contouring, libfive's triangle count"]["details"]
+    plain = g["dual contouring, feature size 0.1"]["details"]
+    if not abs(matched["triangles"] / 20000 - 1) <= 0.1 or plain["feature_size"] != 0.1:
+        sys.exit(f"FAIL: matched sphereGyroid: {matched} (plain {plain})")
+    near(matched["triangles_over_libfive"], matched["triangles"] / 20000, 1e-12, "triangles_over_libfive")
+    if not 0 < matched["mean_distance_over_feature"] <= matched["max_distance_over_feature"] < 1:
+        sys.exit(f"FAIL: sphereGyroid distances: {matched}")
+    goals = [r for r in cases["sphere-gyroid-0.1"]["ratios"] if "goal_ratio" in r]
+    if [(r["ictk"], r["goal_ratio"]) for r in goals] != [("dual contouring, libfive's triangle count", 12)]:
+        sys.exit(f"FAIL: sphereGyroid goal: {goals}")
+    csg3 = cases["csg3-64"]
+    if [s["tool"] for s in csg3["sides"]] != ["ICTK", "VTK"] or csg3["ratios"][0]["goal_ratio"] != 15:
+        sys.exit(f"FAIL: csg3 sides: {csg3}")
+    # l5bench was asked for the sizes of --quick and the rounds' runs, with the model given.
+    calls = open(os.path.join(work, "args.log")).read().split("\n")
+    model = os.path.join(models, "prospero.vm")
+    for want in (f"brute {model} 1 128", f"pruned {model} 2 1 128", f"signonly {model} 2 1 128", "gyroid 2 1"):
+        if calls.count(want) != 3:
+            sys.exit(f"FAIL: l5bench calls: {want!r} {calls.count(want)} times in {calls}")
+    # The Markdown tables of the plain report.
+    out = run(ictk, ["bench", "--quick", "--rounds", "1", "--only", "pruned", "--models", models,
+                     "--peer-libfive", fake]).stdout
+    if "| prospero-pruned-128 | 2 | libfive | Heightmap (with normals) | 125 ms |" not in out \
+            or "Ratios (peer time / ICTK time" not in out:
+        sys.exit(f"FAIL: plain peer report:\n{out}")
+    # A peer that fails, and one that is not there, are errors that name it.
+    env = dict(os.environ, FAKE_L5BENCH_FAIL="brute")
+    p = subprocess.run([ictk, "bench", "--quick", "--only", "brute", "--models", models,
+                        "--peer-libfive", fake], capture_output=True, text=True, timeout=100, env=env)
+    if p.returncode != 2 or f"'{fake} brute {model} 1 128' failed (exit status 3)" not in p.stderr:
+        sys.exit(f"FAIL: failing peer: exit {p.returncode}\n{p.stderr}")
+    p = run(ictk, ["bench", "--quick", "--peer-libfive", os.path.join(work, "nope")], check=False)
+    if p.returncode != 2 or "is not an executable file" not in p.stderr:
+        sys.exit(f"FAIL: missing peer: exit {p.returncode}\n{p.stderr}")
 
 
 def check_bench_scaling(ictk, work):
@@ -1062,6 +1173,7 @@ def main():
         "model-files": check_model_files,
         "bench": check_bench,
         "bench-scaling": check_bench_scaling,
+        "bench-peer": check_bench_peer,
         "run-space-time": check_run_space_time,
         "render": check_render,
     }

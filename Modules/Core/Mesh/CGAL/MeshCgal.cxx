@@ -9,7 +9,11 @@
 #include "Complex/Discretization.h"
 #include "Discretize/Curves.h"
 #include "FRep/Sampling.h"
+#include "FRep/Threads.h"
 #include "FRep/Vector.h"
+
+// Slivers_exuder's Parallel_tag code uses the work-sharing structures without including them.
+#include <CGAL/Mesh_3/Worksharing_data_structures.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Labeled_mesh_domain_3.h>
@@ -23,6 +27,7 @@
 #include <CGAL/perturb_mesh_3.h>
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -50,9 +55,16 @@ using Polyline = std::vector<Point3>;
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using BaseDomain = CGAL::Labeled_mesh_domain_3<K>;
 using Domain = CGAL::Mesh_domain_with_polyline_features_3<BaseDomain>;
-using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
-using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
-using Criteria = CGAL::Mesh_criteria_3<Tr>;
+/// The triangulation types of one concurrency mode: CGAL::Sequential_tag (the deterministic mode,
+/// and one thread) or CGAL::Parallel_tag (refinement, perturbation and exudation on TBB threads).
+template <class Concurrency>
+struct Mesh3
+{
+  using Tr = typename CGAL::Mesh_triangulation_3<Domain, CGAL::Default, Concurrency>::type;
+  using C3t3 =
+    CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
+  using Criteria = CGAL::Mesh_criteria_3<Tr>;
+};
 
 /// Facet and cell circumradius bounds per unit of TetraOptions::size (see tetrahedralizeCgal).
 constexpr double kFacetRadius = 0.75;
@@ -1172,6 +1184,7 @@ void checkOptions(const TetraOptions& options)
 /// label (a grid search in its box), then CGAL's own segment intersection along 14 directions
 /// from it. Points near a protected curve are skipped (a point inside a protecting ball is hidden
 /// by it anyway; one just outside would crowd it).
+template <class C3t3>
 void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& solids,
   Labeller& labeller, const std::vector<Polyline>& features, const Box3& outer, double size)
 {
@@ -1242,7 +1255,7 @@ void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& so
             continue;
           }
           const auto v = c3t3.triangulation().insert(cwp(q));
-          if (v != Tr::Vertex_handle())
+          if (v != typename C3t3::Triangulation::Vertex_handle())
           {
             c3t3.set_dimension(v, 2);
             c3t3.set_index(v, domain.index_from_surface_patch_index(*surface));
@@ -1252,6 +1265,101 @@ void seedSurfaces(C3t3& c3t3, const Domain& domain, const std::vector<Solid>& so
       }
     }
   }
+}
+
+/// make_mesh_3's steps on the domain, with initial surface points on every solid, and the
+/// tetrahedra of the complex as a TetMesh (materials 1..n; labels above n are patch sub-labels).
+template <class Concurrency>
+TetMesh refine(const Domain& domain, const std::vector<Solid>& solids, Labeller& labeller,
+  const std::vector<Polyline>& features, const Box3& outer, const TetraOptions& options,
+  ProgressScope& progress, int n)
+{
+  using C3t3 = typename Mesh3<Concurrency>::C3t3;
+  // CGAL's sizes are circumradius bounds. Delaunay refinement leaves most elements well below
+  // them: with the regular-element radii (h / sqrt 3, h sqrt(6) / 4) the sphere-in-box benchmark
+  // came out with 2.3 times estimateTetrahedra's count (mean element about 0.76 h). These bounds
+  // make the mean tetrahedron about the volume of a regular one of edge h, as the estimate says.
+  const double h = options.size;
+  namespace p = CGAL::parameters;
+  typename Mesh3<Concurrency>::Criteria criteria(p::edge_size = h, p::facet_angle = 25,
+    p::facet_size = kFacetRadius * h, p::facet_distance = 0.1 * h, p::cell_radius_edge_ratio = 3,
+    p::cell_size = kCellRadius * h);
+
+  labeller.setPhase(0.1);
+  // make_mesh_3's steps, with initial surface points on every solid. make_mesh_3's own seeding
+  // (random rays from the centre of the box, and only when the protected curves give no surface
+  // facet) is not used: it misses solids away from the curves (the flower's stamen), and a centre
+  // on an interface (the two-material bar's) put dozens of points within 1e-8 of each other there.
+  typename Mesh3<Concurrency>::C3t3 c3t3;
+  if (!features.empty())
+  {
+    CGAL::Mesh_3::internal::init_c3t3_with_features(c3t3, domain, criteria);
+  }
+  seedSurfaces(c3t3, domain, solids, labeller, features, outer, h);
+  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::no_reset_c3t3());
+  progress.report(0.6);
+  if (!options.deterministic)
+  {
+    labeller.setPhase(0.6);
+    CGAL::perturb_mesh_3(
+      c3t3, domain, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
+    progress.report(0.8);
+  }
+  labeller.setPhase(0.8);
+  CGAL::exude_mesh_3(
+    c3t3, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
+  progress.report(0.95);
+
+  // Output: the tetrahedra of the complex, vertices numbered in order of first use.
+  TetMesh mesh;
+  for (const Solid& s : solids)
+  {
+    mesh.materialNames.push_back(s.name);
+  }
+  const typename C3t3::Triangulation& tr = c3t3.triangulation();
+  // Vertices are found by their time stamps (unique, below the number of vertices ever inserted):
+  // an array lookup instead of a hash map that missed the cache four times per tetrahedron.
+  std::size_t stamps = 0;
+  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v)
+  {
+    stamps = std::max(stamps, v->time_stamp() + 1);
+  }
+  constexpr std::uint32_t unused = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> index(stamps, unused);
+  mesh.tetrahedra.reserve(c3t3.number_of_cells_in_complex());
+  mesh.cells.reserve(c3t3.number_of_cells_in_complex());
+  mesh.materials.reserve(c3t3.number_of_cells_in_complex());
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
+  {
+    const int subLabel = static_cast<int>(c3t3.subdomain_index(c));
+    if (subLabel < 1)
+    {
+      continue;
+    }
+    const int label = (subLabel - 1) % n + 1;
+    std::array<std::uint32_t, 4> tet{};
+    for (int k = 0; k < 4; ++k)
+    {
+      std::uint32_t& i = index[c->vertex(k)->time_stamp()];
+      if (i == unused)
+      {
+        i = static_cast<std::uint32_t>(mesh.points.size());
+        const auto& wp = tr.point(c, k);
+        mesh.points.push_back(
+          { CGAL::to_double(wp.x()), CGAL::to_double(wp.y()), CGAL::to_double(wp.z()) });
+      }
+      tet[k] = i;
+    }
+    if (orientation(
+          mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]) < 0)
+    {
+      std::swap(tet[2], tet[3]);
+    }
+    mesh.tetrahedra.push_back(tet);
+    mesh.cells.push_back(solids[static_cast<std::size_t>(label - 1)].id);
+    mesh.materials.push_back(label);
+  }
+  return mesh;
 }
 
 } // namespace
@@ -1267,6 +1375,18 @@ std::vector<std::vector<Point3>> cgalFeatureCurves(
     solids, padded(box, 0.02 * diagonal(box) + options.size), 1e-3 * options.size, unreported);
   const auto patches = collectPatches(complex, solids, labeller, options);
   return featureCurves(complex, solids, patches, box, options);
+}
+
+bool cgalMeshesInParallel(const TetraOptions& options)
+{
+#ifdef CGAL_LINKED_WITH_TBB
+  const int threads =
+    options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
+  return !options.deterministic && threads > 1;
+#else
+  (void)options;
+  return false;
+#endif
 }
 
 TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& options)
@@ -1336,88 +1456,20 @@ TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& 
     domain.add_features(lines.begin(), lines.end());
   }
 
-  // CGAL's sizes are circumradius bounds. Delaunay refinement leaves most elements well below
-  // them: with the regular-element radii (h / sqrt 3, h sqrt(6) / 4) the sphere-in-box benchmark
-  // came out with 2.3 times estimateTetrahedra's count (mean element about 0.76 h). These bounds
-  // make the mean tetrahedron about the volume of a regular one of edge h, as the estimate says.
-  const double h = options.size;
-  namespace p = CGAL::parameters;
-  Criteria criteria(p::edge_size = h, p::facet_angle = 25, p::facet_size = kFacetRadius * h,
-    p::facet_distance = 0.1 * h, p::cell_radius_edge_ratio = 3, p::cell_size = kCellRadius * h);
-
-  labeller->setPhase(0.1);
-  // make_mesh_3's steps, with initial surface points on every solid. make_mesh_3's own seeding
-  // (random rays from the centre of the box, and only when the protected curves give no surface
-  // facet) is not used: it misses solids away from the curves (the flower's stamen), and a centre
-  // on an interface (the two-material bar's) put dozens of points within 1e-8 of each other there.
-  C3t3 c3t3;
-  if (!features.empty())
-  {
-    CGAL::Mesh_3::internal::init_c3t3_with_features(c3t3, domain, criteria);
-  }
-  seedSurfaces(c3t3, domain, solids, *labeller, features, outer, h);
-  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::no_reset_c3t3());
-  progress.report(0.6);
-  if (!options.deterministic)
-  {
-    labeller->setPhase(0.6);
-    CGAL::perturb_mesh_3(
-      c3t3, domain, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
-    progress.report(0.8);
-  }
-  labeller->setPhase(0.8);
-  CGAL::exude_mesh_3(
-    c3t3, p::time_limit = 0, p::sliver_bound = std::max(0.0, options.minDihedralDegrees));
-  progress.report(0.95);
-
-  // Output: the tetrahedra of the complex, vertices numbered in order of first use.
   TetMesh mesh;
-  for (const Solid& s : solids)
+  if (cgalMeshesInParallel(options))
   {
-    mesh.materialNames.push_back(s.name);
-  }
-  const Tr& tr = c3t3.triangulation();
-  // Vertices are found by their time stamps (unique, below the number of vertices ever inserted):
-  // an array lookup instead of a hash map that missed the cache four times per tetrahedron.
-  std::size_t stamps = 0;
-  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v)
-  {
-    stamps = std::max(stamps, v->time_stamp() + 1);
-  }
-  constexpr std::uint32_t unused = std::numeric_limits<std::uint32_t>::max();
-  std::vector<std::uint32_t> index(stamps, unused);
-  mesh.tetrahedra.reserve(c3t3.number_of_cells_in_complex());
-  mesh.cells.reserve(c3t3.number_of_cells_in_complex());
-  mesh.materials.reserve(c3t3.number_of_cells_in_complex());
-  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
-  {
-    const int subLabel = static_cast<int>(c3t3.subdomain_index(c));
-    if (subLabel < 1)
-    {
-      continue;
-    }
-    const int label = (subLabel - 1) % n + 1;
-    std::array<std::uint32_t, 4> tet{};
-    for (int k = 0; k < 4; ++k)
-    {
-      std::uint32_t& i = index[c->vertex(k)->time_stamp()];
-      if (i == unused)
+    runOnThreads(options.threads,
+      [&]
       {
-        i = static_cast<std::uint32_t>(mesh.points.size());
-        const auto& wp = tr.point(c, k);
-        mesh.points.push_back(
-          { CGAL::to_double(wp.x()), CGAL::to_double(wp.y()), CGAL::to_double(wp.z()) });
-      }
-      tet[k] = i;
-    }
-    if (orientation(
-          mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]) < 0)
-    {
-      std::swap(tet[2], tet[3]);
-    }
-    mesh.tetrahedra.push_back(tet);
-    mesh.cells.push_back(solids[static_cast<std::size_t>(label - 1)].id);
-    mesh.materials.push_back(label);
+        mesh = refine<CGAL::Parallel_tag>(
+          domain, solids, *labeller, features, outer, options, progress, n);
+      });
+  }
+  else
+  {
+    mesh = refine<CGAL::Sequential_tag>(
+      domain, solids, *labeller, features, outer, options, progress, n);
   }
   // A solid with no tetrahedron would silently be missing from the mesh (and from a solver's
   // element sets): refuse it by name.

@@ -28,9 +28,11 @@ namespace ictk::mesh
 /// A tetrahedral mesh of the complex's 3D cells (implicit cells only; cellData is left empty).
 /// options.size is met on average: the mean tetrahedron has the volume of a regular one of edge
 /// `size` (so estimateTetrahedra predicts the count) and protected curves get edges of at most
-/// `size`. Refinement is sequential (options.threads is used for tracing the curves only).
-/// Sliver exudation (deterministic: no random choice, no time limit) aims at
-/// options.minDihedralDegrees in both modes; the default mode perturbs vertices first (random).
+/// `size`. In the default mode on more than one thread (options.threads, 0: every core),
+/// refinement, perturbation and exudation run on CGAL's parallel code (Parallel_tag, TBB; see
+/// cgalMeshesInParallel); the deterministic mode is always sequential. Sliver exudation
+/// (deterministic: no random choice, no time limit) aims at options.minDihedralDegrees in both
+/// modes; the default mode perturbs vertices first (random).
 /// options.deterministic: no perturbation and fixed seeds, identical output run to run and
 /// thread count to thread count (the flower: min dihedral 6.3 deg instead of 0.3 without
 /// exudation, 9.5 deg with perturbation).
@@ -40,6 +42,11 @@ namespace ictk::mesh
 /// options.maxTetrahedra (giving the estimate); frep::Cancelled when options.progress asks to
 /// stop.
 TetMesh tetrahedralizeCgal(const complex::Complex& complex, const TetraOptions& options);
+
+/// Whether tetrahedralizeCgal refines with CGAL's Parallel_tag for these options: not in the
+/// deterministic mode (the parallel result depends on the threads' timing), not on one thread,
+/// and only when the library was built with CGAL's TBB support.
+bool cgalMeshesInParallel(const TetraOptions& options);
 
 /// The polylines the backend protects (after merging duplicates, snapping end points and
 /// splitting at junctions), for tests and viewers.
