@@ -149,9 +149,7 @@ Value makeCrossSection(const LibraryCall& call)
     throw std::runtime_error("makeCrossSection: the shape of " + c.name +
       " is cut at t = " + std::to_string(t) +
       ", but the model is evaluating t = " + std::to_string(now) + " (pass globalT)");
-  Value v = call.args[0];
-  v.fields["crossSectionTime"] = t;
-  return v;
+  return call.args[0];
 }
 
 /// getVolume(shape) (thesis L3162): the measure of the cell's shape as placed now.
