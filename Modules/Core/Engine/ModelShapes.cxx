@@ -430,7 +430,8 @@ void ModelState::rebuildShape(const CellSpec& c)
   now.name = c.name;
   now.dimension = c.dimension;
   buildShapeParts(now, *c.shapeExpression, s.active);
-  const std::vector<ShapePart>& was = *partsOf(c);
+  const std::shared_ptr<const std::vector<ShapePart>> before = partsOf(c);
+  const std::vector<ShapePart>& was = *before;
   bool same = was.size() == now.parts.size();
   for (std::size_t i = 0; same && i < was.size(); ++i)
     same = was[i].kind == now.parts[i].kind && was[i].points == now.parts[i].points &&
