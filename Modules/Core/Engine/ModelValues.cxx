@@ -3,6 +3,7 @@
 // name, value paths (Cell.translation.x), the placement and placed shape of a cell, the version
 // that tells when a shape changed, and the scope through which code sees names and members.
 #include "Engine/ModelState.h"
+#include "FRep/Vector.h"
 
 #include <algorithm>
 #include <cstring>
@@ -273,13 +274,7 @@ Affine boxOntoBox(const frep::Box3& from, const frep::Box3& to)
 
 frep::Box3 lerpBox(const frep::Box3& a, const frep::Box3& b, double u)
 {
-  frep::Box3 r;
-  for (int k = 0; k < 3; ++k)
-  {
-    r.lo[k] = a.lo[k] + u * (b.lo[k] - a.lo[k]);
-    r.hi[k] = a.hi[k] + u * (b.hi[k] - a.hi[k]);
-  }
-  return r;
+  return { frep::lerp(a.lo, b.lo, u), frep::lerp(a.hi, b.hi, u) };
 }
 
 } // namespace
