@@ -291,7 +291,14 @@ bool SampleSeries(const GridPlan& plan, int threads, bool asDouble,
   {
     return false;
   }
-  ThrowIfVtkFailed(messages, errorsBefore, "cannot sample the frames into '" + pvd + "'");
+  // The writer's own errors name the series, the frame and its file: given as they are.
+  if (messages->Errors.size() > errorsBefore)
+  {
+    const std::string cause = messages->FirstCause(errorsBefore);
+    throw UserError(cause.rfind("cannot write", 0) == 0
+        ? cause
+        : "cannot sample the frames into '" + pvd + "': " + cause);
+  }
   if (!written)
   {
     throw UserError("cannot sample the frames into '" + pvd + "'");

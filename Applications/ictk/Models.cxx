@@ -39,11 +39,23 @@ ModelFileError AsModelFileError(const lang::ParseError& e)
   return ModelFileError(text);
 }
 
+namespace
+{
+bool strictHyperFun = false;
+}
+
+void ReadHyperFunStrictly(bool strict)
+{
+  strictHyperFun = strict;
+}
+
 lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>& params)
 {
   try
   {
-    return lang::loadModelFile(path, {}, params);
+    lang::Limits limits;
+    limits.strictHyperFun = strictHyperFun;
+    return lang::loadModelFile(path, limits, params);
   }
   catch (const lang::ParseError& e)
   {

@@ -28,6 +28,10 @@ ModelFileError AsModelFileError(const lang::ParseError& e);
 
 /// Opens a model file (.hf, .xml), specialised to `params` (a HyperFun file's library may need
 /// them where it wants numbers).
+/// `ictk --strict` (main's, set once at start): model files' HyperFun read as HyperFun's own
+/// interpreter reads it (lang::Limits::strictHyperFun).
+void ReadHyperFunStrictly(bool strict);
+
 lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>& params = {});
 
 /// A model ready to sample: its hypervolume and a box that holds it.

@@ -3,11 +3,10 @@
 
 #include "Command.h"
 
+#include "ictkFileWriting.h"
 #include "ictkTetrahedralize.h"
 
 #include <vtkDataObject.h>
-#include <vtkDataObjectTree.h>
-#include <vtkDataObjectTreeIterator.h>
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
@@ -87,34 +86,27 @@ void AtomicOutput::Fail(const std::string& why) const
 
 void AtomicOutput::Write(const std::string& bytes)
 {
-  const int fd = ::open(this->Temporary.c_str(), O_WRONLY | O_TRUNC);
-  if (fd < 0)
+  try
   {
-    this->Fail(std::strerror(errno));
+    vtk::writeWholeFile(this->Temporary, bytes);
   }
-  std::size_t done = 0;
-  while (done < bytes.size())
+  catch (const std::runtime_error& e)
   {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR)
-    {
-      continue;
-    }
-    if (n <= 0)
-    {
-      const int error = n < 0 ? errno : ENOSPC;
-      ::close(fd);
-      this->Fail(std::strerror(error));
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::close(fd) != 0)
-  {
-    this->Fail(std::strerror(errno));
+    this->Fail(e.what());
   }
 }
 
 void AtomicOutput::Commit()
+{
+  this->Verify();
+  if (std::rename(this->Temporary.c_str(), this->Destination.c_str()) != 0)
+  {
+    throw UserError("cannot write '" + this->Destination + "': " + std::strerror(errno));
+  }
+  this->Temporary.clear();
+}
+
+void AtomicOutput::Verify() const
 {
   const int fd = ::open(this->Temporary.c_str(), O_RDONLY);
   struct stat st
@@ -148,11 +140,6 @@ void AtomicOutput::Commit()
   {
     this->Fail(std::strerror(ENOSPC));
   }
-  if (std::rename(this->Temporary.c_str(), this->Destination.c_str()) != 0)
-  {
-    throw UserError("cannot write '" + this->Destination + "': " + std::strerror(errno));
-  }
-  this->Temporary.clear();
 }
 
 void WriteXml(vtkXMLWriter* writer, vtkDataObject* data, AtomicOutput& file)
@@ -168,56 +155,14 @@ void WriteXml(vtkXMLWriter* writer, vtkDataObject* data, AtomicOutput& file)
 
 namespace
 {
-/// Refuses, before writing, a composite whose pieces may not fit: VTK's XML writers can crash
-/// when their stream fails mid-file, and the pieces are written by VTK's composite writers
-/// themselves. Every piece's size in memory bounds its compressed file: the largest against the
-/// file size limit (ulimit -f), their sum against the free space of the destination's disk.
+/// Refuses, before writing, a composite whose pieces may not fit (ictkFileWriting.h): the pieces
+/// are written by VTK's composite writers themselves, which can crash when a stream fails.
 void CheckRoomForPieces(vtkDataObject* data, const fs::path& folder, const std::string& output)
 {
-  std::uint64_t total = 0;
-  std::uint64_t largest = 0;
-  auto add = [&](vtkDataObject* piece)
+  const std::string why = vtk::piecesDoNotFit(data, folder.string());
+  if (!why.empty())
   {
-    const std::uint64_t bytes = static_cast<std::uint64_t>(piece->GetActualMemorySize()) * 1024;
-    total += bytes;
-    largest = std::max(largest, bytes);
-  };
-  if (auto* tree = vtkDataObjectTree::SafeDownCast(data))
-  {
-    vtkSmartPointer<vtkDataObjectTreeIterator> it;
-    it.TakeReference(tree->NewTreeIterator());
-    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
-    {
-      add(it->GetCurrentDataObject());
-    }
-  }
-  else
-  {
-    add(data);
-  }
-  auto megabytes = [](std::uint64_t bytes)
-  {
-    return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MB";
-  };
-  struct rlimit limit
-  {};
-  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
-    largest > limit.rlim_cur)
-  {
-    throw UserError("cannot write '" + output + "': a piece may need up to " +
-      std::to_string(largest) + " bytes, over the file size limit (ulimit -f) of " +
-      std::to_string(limit.rlim_cur) + " bytes; nothing written");
-  }
-  struct statvfs disk
-  {};
-  if (::statvfs(folder.c_str(), &disk) == 0)
-  {
-    const std::uint64_t free = static_cast<std::uint64_t>(disk.f_bavail) * disk.f_frsize;
-    if (total > free)
-    {
-      throw UserError("cannot write '" + output + "': its pieces may need up to " +
-        megabytes(total) + " and the disk has " + megabytes(free) + " free; nothing written");
-    }
+    throw UserError("cannot write '" + output + "': " + why + "; nothing written");
   }
 }
 } // namespace

@@ -39,6 +39,9 @@ public:
   /// the disk, and not cut short by a full disk or the file size limit (`ulimit -f`), which
   /// writers that ignore their stream's errors (vtkOBJWriter) would not report.
   void Commit();
+  /// Commit's checks without the move: throws the UserError of Fail() unless the temporary file
+  /// is complete. A command writing several files checks them all before moving any.
+  void Verify() const;
   /// Throws the UserError "cannot write '<destination>': <why>; nothing written".
   [[noreturn]] void Fail(const std::string& why) const;
 

@@ -297,6 +297,11 @@ std::string FrameOutput::Commit()
     this->Committed = true;
     return this->Output;
   }
+  // Every frame is known complete before the first one replaces a file of the same name.
+  for (auto& frame : this->Frames)
+  {
+    frame->Verify();
+  }
   for (auto& frame : this->Frames)
   {
     frame->Commit();

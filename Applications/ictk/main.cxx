@@ -14,6 +14,7 @@
 // diagnostics are printed as they are); nothing is left half-written (Output.h).
 
 #include "Command.h"
+#include "Models.h"
 #include "VtkMessages.h"
 
 #include "Lang/Diagnostics.h"
@@ -43,6 +44,10 @@ int Run(int argc, char** argv)
   // shows them as VTK wrote them. Given before or after the subcommand (fallthrough).
   bool verbose = false;
   app.add_flag("--verbose", verbose, "Also print VTK's own error and warning reports");
+  bool strict = false;
+  app.add_flag("--strict", strict,
+    "Read .hf files as HyperFun's own interpreter does: what ICTK accepts beyond it (its own "
+    "library functions, calls of functions defined later) is an error (docs/hyperfun.md)");
   app.fallthrough();
 
   // In the order `ictk --help` lists them.
@@ -88,6 +93,7 @@ int Run(int argc, char** argv)
   }
 
   CaptureVtkMessages(verbose);
+  ReadHyperFunStrictly(strict);
   for (std::size_t i = 0; i < commands.size(); ++i)
   {
     if (*subcommands[i])

@@ -162,9 +162,10 @@ TEST(DataModels, MathFunctions)
 
 TEST(DataModels, FunctionsCallingEachOther)
 {
-  // chain = a[2] * (b1 | b2 | b3) + a[1], the beads being balls of radius 0.5 at x = -1, 0, 1.
+  // my_model = a[2] * (b1 | b2 | b3) + a[1], the beads being balls of radius 0.5 at x = -1, 0,
+  // 1: the model is my_model, though another function comes first (HyperFun's rule).
   const auto m = load("functions.hf");
-  EXPECT_EQ(m.name, "chain");
+  EXPECT_EQ(m.name, "my_model");
   EXPECT_EQ(m.parameterCount, 2);
   const Shape beads =
     frep::unite(frep::unite(frep::sphere({ -1, 0, 0 }, 0.5), frep::sphere({ 0, 0, 0 }, 0.5)),

@@ -429,6 +429,34 @@ TEST(EngineInterpreter, CoreConstructs)
   EXPECT_DOUBLE_EQ(t.vec[2], 3.5);
 }
 
+// A loop bound the model sets (a user number that sets the work) is refused before the loop
+// runs, with the limit, at the loop's place.
+TEST(EngineInterpreter, LoopBoundOverTheLimitIsRefused)
+{
+  const std::string text =
+    "function count(int n) { int s = 0; for i in 0..n { s += 1; } return s; }\n"
+    "STATE_PARAMETERS { total : INT(0); }\n"
+    "CELLS { A { type = F-CELL; shape = disk(1); dim = 2D; } }\n"
+    "K : TEMPLATE_IC { CELLS { A; } }\n"
+    "ONE : K { REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) {\n"
+    "  total = count(100000000);\n"
+    "} } }\n";
+  try
+  {
+    DynamicModel m = fromText(text);
+    m.advanceTo(0.1, 0.1);
+    ADD_FAILURE() << "a loop of 1e8 iterations ran";
+  }
+  catch (const ModelError& e)
+  {
+    EXPECT_EQ(e.pos.line, 1);
+    EXPECT_NE(std::string(e.what()).find("the loop would run more than 10000000 iterations in one "
+                                         "reaction"),
+      std::string::npos)
+      << e.what();
+  }
+}
+
 TEST(EngineInterpreter, TypeErrorsAtRunTime)
 {
   // A BOOL state parameter assigned a number: caught where it happens (line 4).

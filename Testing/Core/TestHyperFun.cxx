@@ -298,12 +298,62 @@ TEST(HyperFun, SeveralFunctionsCallingEachOther)
                            "shifted(x[3], b[1]) {\n array xt[3], r[1];\n xt = x;\n r = [2];\n"
                            " hfShift3D(xt, 1, 0, 0);\n shifted = ball(xt, r);\n}\n";
   // The callee's a[1] is the caller's r[1] = 2.
-  const auto g = geometry(text);
+  const auto g = geometry(text, "shifted");
   expectSameField(g,
     frep::Shape(
       frep::shift(frep::sphere({ 0, 0, 0 }, 1), { 1, 0, 0 }).function() + 2.0, frep::Domain::XYZ));
   // Choosing a function by name.
   EXPECT_EQ(readHyperFun(text, "f.hf", "BALL").name, "ball");
+}
+
+TEST(HyperFun, TheModelIsMyModelElseTheFirstFunction)
+{
+  // As HyperFun's interpreter (hfp -o, default my_model; a name not in the file: the first).
+  const std::string first = "a(x[3], p[1]) {\n a = 1 - x[1];\n}\nb(x[3], p[1]) {\n b = 2;\n}\n";
+  const auto model = readHyperFun(first, "f.hf");
+  EXPECT_EQ(model.name, "a");
+  EXPECT_EQ(at(model.model.geometry(), 0.25, 0, 0), 0.75);
+  const std::string named = first + "my_model(x[3], p[1]) {\n my_model = 3 - x[2];\n}\n";
+  EXPECT_EQ(readHyperFun(named, "f.hf").name, "my_model");
+  EXPECT_EQ(at(geometry(named), 0, 0.5, 0), 2.5);
+}
+
+TEST(HyperFun, StrictRefusesWhatHyperFunDoesNotRead)
+{
+  lang::Limits strict;
+  strict.strictHyperFun = true;
+  // A call of a function defined later in the file (HyperFun calls only earlier ones).
+  const std::string later = "my_model(x[3], a[1]) {\n my_model = ball(x, a) + 1;\n}\n"
+                            "ball(x[3], a[1]) {\n array c[3];\n c = [0, 0, 0];\n"
+                            " ball = hfSphere(x, c, 1);\n}\n";
+  EXPECT_EQ(at(geometry(later), 0, 0, 0), 2.0); // ICTK reads it
+  lang::ParseError e = errorOf(later, strict);
+  ASSERT_EQ(e.diagnostics().size(), 1u);
+  EXPECT_EQ(e.diagnostics()[0].where.line, 2);
+  EXPECT_EQ(e.diagnostics()[0].where.column, 13);
+  EXPECT_EQ(e.diagnostics()[0].message,
+    "'ball' is defined after 'my_model': HyperFun calls only functions defined before the caller "
+    "(refused by --strict)");
+  // The same two functions in HyperFun's order read the same under --strict.
+  const std::string before = "ball(x[3], a[1]) {\n array c[3];\n c = [0, 0, 0];\n"
+                             " ball = hfSphere(x, c, 1);\n}\n"
+                             "my_model(x[3], a[1]) {\n my_model = ball(x, a) + 1;\n}\n";
+  EXPECT_EQ(at(readHyperFun(before, "f.hf", {}, strict).model.geometry(), 0, 0, 0), 2.0);
+  // ICTK's own library functions.
+  for (const char* call : { "hfGyroid(x, 1, 0.1)", "hfPin(x, o, o, 0.1, 1)" })
+  {
+    SCOPED_TRACE(call);
+    const std::string text =
+      std::string("m(x[3], a[1]) {\n array o[3];\n o = [0, 0, 1];\n m = ") + call + ";\n}\n";
+    EXPECT_NO_THROW(readHyperFun(text, "f.hf"));
+    e = errorOf(text, strict);
+    ASSERT_EQ(e.diagnostics().size(), 1u);
+    EXPECT_EQ(e.diagnostics()[0].where.line, 4);
+    EXPECT_EQ(e.diagnostics()[0].where.column, 6);
+    EXPECT_EQ(e.diagnostics()[0].message,
+      "'" + std::string(call).substr(0, std::string(call).find('(')) +
+        "' is ICTK's own, not in HyperFun's library (refused by --strict)");
+  }
 }
 
 TEST(HyperFun, LoopsAndConstantBranchesFoldToTheClosedForm)

@@ -4,6 +4,7 @@
 #include "FRep/Domain.h"
 #include "FRep/Expr.h"
 #include "FRep/Hypervolume.h"
+#include "FRep/ModelRegistry.h"
 #include "FRep/Primitives.h"
 
 #include "ictkFRepImplicitFunction.h"
@@ -26,11 +27,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace ictk::frep;
@@ -185,6 +188,70 @@ TEST(FRepSampler, SameValuesForAnyThreadCount)
     results.push_back(values);
   }
   EXPECT_EQ(results[0], results[1]);
+}
+
+TEST(FRepSampler, TwoPipelinesOverOneModelInTwoThreads)
+{
+  // Issue 19's concurrency promise: VTK's contract (no state change during an update) is kept
+  // by each pipeline, and the pipelines share one model, whose thread-local evaluators each
+  // thread builds for itself. Two threads each run their own sampler (on 2 threads) and their own
+  // implicit function over one walnut, again and again: every result is the single-threaded one,
+  // bit for bit.
+  const ictk::frep::ModelInfo& info = ictk::frep::findModel("walnut");
+  const Hypervolume walnut = info.build();
+  auto sample = [&](int threads)
+  {
+    vtkNew<ictkFRepSampler> sampler;
+    sampler->SetHypervolume(walnut);
+    sampler->SetModelBounds(info.boundsLo[0], info.boundsHi[0], info.boundsLo[1], info.boundsHi[1],
+      info.boundsLo[2], info.boundsHi[2]);
+    sampler->SetSampleDimensions(24, 24, 24);
+    sampler->SetNumberOfThreads(threads);
+    sampler->Update();
+    vtkDataArray* f = sampler->GetOutput()->GetPointData()->GetArray("f");
+    std::vector<double> values(static_cast<std::size_t>(f->GetNumberOfTuples()));
+    for (vtkIdType i = 0; i < f->GetNumberOfTuples(); ++i)
+    {
+      values[static_cast<std::size_t>(i)] = f->GetComponent(i, 0);
+    }
+    return values;
+  };
+  auto evaluate = [&]
+  {
+    vtkNew<ictkFRepImplicitFunction> function;
+    function->SetHypervolume(walnut);
+    std::vector<double> values;
+    for (int i = 0; i < 2000; ++i)
+    {
+      double p[3] = { -1 + 0.001 * i, 0.3 - 0.0002 * i, 0.0005 * i - 0.5 };
+      values.push_back(function->EvaluateFunction(p));
+    }
+    return values;
+  };
+  const std::vector<double> sampled = sample(1);
+  const std::vector<double> evaluated = evaluate();
+  ASSERT_GT(*std::max_element(sampled.begin(), sampled.end()), 0.0); // inside and outside
+  ASSERT_LT(*std::min_element(sampled.begin(), sampled.end()), 0.0);
+  std::array<int, 2> same{ 0, 0 };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 2; ++t)
+  {
+    threads.emplace_back(
+      [&, t]
+      {
+        for (int round = 0; round < 4; ++round)
+        {
+          same[static_cast<std::size_t>(t)] += sample(2) == sampled;
+          same[static_cast<std::size_t>(t)] += evaluate() == evaluated;
+        }
+      });
+  }
+  for (std::thread& thread : threads)
+  {
+    thread.join();
+  }
+  EXPECT_EQ(same[0], 8);
+  EXPECT_EQ(same[1], 8);
 }
 
 TEST(FRepSampler, RegisteredModelUsesItsBounds)

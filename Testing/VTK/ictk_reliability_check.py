@@ -6,6 +6,11 @@ Usage: ictk_reliability_check.py --ictk PATH --work DIR CHECK [DATA]
   reader-errors        broken voxel and mesh files in a complex: one diagnostic naming the file
                        and what was wrong, exit 2, no VTK text (VTK's text with --verbose)
   faults DATA [tetgen]  writers past the file size limit (as a full disk) and in a read-only folder
+  series-faults DATA   .pvd series (run, sample --frames) and render --frames filling the disk
+                       mid-run: the frame and its file named, exit 2, the earlier series kept
+  hyperfun-strict DATA `ictk --strict` refuses ICTK's HyperFun extensions at their place
+  vanishing-files DATA SHIM  files cut short or gone while ictk reads them (SHIM: ictkFaultRead,
+                       loaded with LD_PRELOAD): one diagnostic naming the file, exit 2, no output
   mesh-2d DATA         a 2D model (x[2]) meshed as its boundary curve; .stl refused with the why
   determinism-COMMAND DATA [BACKENDS...]   the same command on 1, 2 and 8 threads writes
                        byte-identical files (COMMAND: sample, mesh, tetra, run, render; tetra with
@@ -297,6 +302,177 @@ def check_faults(ictk, work, data):
             sys.exit(f"FAIL: {name} in a read-only folder: exit {p.returncode}, stderr:\n{p.stderr}")
 
 
+def frame_sizes(folder, pattern):
+    """The largest file of each frame (its file, or its pieces), by frame number."""
+    sizes = {}
+    for name in tree(folder):
+        m = re.search(pattern, name)
+        if m:
+            k = int(next(g for g in m.groups() if g is not None))
+            sizes[k] = max(sizes.get(k, 0), os.path.getsize(os.path.join(folder, name)))
+    return [sizes[k] for k in sorted(sizes)]
+
+
+def check_series_faults(ictk, work, data):
+    """A series whose frames fill the disk mid-run (the file size limit, as in check_faults, set
+    between the first frames' sizes and a later frame's): exit 2, one line naming the frame and
+    its file, no crash, the earlier series of the same name kept whole (its .pvd and frames),
+    nothing else left behind."""
+    models = os.path.join(data, "Models")
+    cases = [
+        ("run", ["run", os.path.join(models, "icm", "ch5_1_disk_rectangle.icm"), "--frames", "0:6:0.5"],
+         "series.pvd", r"series_(\d+)\.vtpc|series_(\d+)/"),
+        ("sample", ["sample", "morph", "--resolution", "24", "--frames", "0.125:0.875:0.125"],
+         "series.pvd", r"series_(\d+)\.vti"),
+        ("render", ["render", "morph", "--size", "64,64", "--frames", "0:1:0.125"],
+         "frames/%04d.png", r"(\d+)\.png"),
+    ]
+    for command, args, output, pattern in cases:
+        # The series as it is when nothing fails: the earlier result, and the frames' sizes.
+        folder = os.path.join(work, command)
+        os.makedirs(folder)
+        target = os.path.join(folder, output)
+        run(ictk, args + ["-o", target])
+        before = {name: open(os.path.join(folder, name), "rb").read() for name in tree(folder)}
+        sizes = frame_sizes(folder, pattern)
+        # The limit: lowered from well above every file until the series fails. A single file
+        # fails when it reaches the limit, so the first failure is at the first frame whose
+        # largest file is the largest of all (a later frame for these models: mid-run); a
+        # composite frame is refused when one of its pieces may not fit (their sizes in memory,
+        # not known here), so its frame is read from the message. A run that succeeds rewrites
+        # the same bytes (Reliability.Determinism), so the earlier series stays as it was.
+        expected = next((k for k in range(1, len(sizes)) if sizes[k] > max(sizes[:k])), None)
+        if command == "run":
+            limit = 4 * max(sizes)
+            while True:
+                p = run_limited(ictk, args + ["-o", target], limit)
+                if p.returncode != 0 or limit < 64:
+                    break
+                limit = int(limit * 0.9)
+        elif expected is None:
+            sys.exit(f"FAIL: {command}: no frame larger than the ones before it ({sizes})")
+        else:
+            limit = max(sizes[:expected]) + 1
+            p = run_limited(ictk, args + ["-o", target], limit)
+        lines = p.stderr.strip().splitlines()
+        m = re.search(r"frame (\d+) of|(\d+)\.png'", lines[-1] if lines else "")
+        failing = int(next(g for g in m.groups() if g is not None)) if m else -1
+        if command == "run":
+            expected = failing
+        if command == "render":
+            frame = os.path.join(folder, "frames", f"{failing:04d}.png")
+            want = f"ictk: error: cannot write '{re.escape(frame)}': .*"
+        else:
+            ext = "vtpc" if command == "run" else "vti"
+            frame = os.path.join(folder, "series", f"series_{failing:04d}.{ext}")
+            want = (f"ictk: error: cannot write frame {failing} of '{re.escape(target)}' "
+                    f"\\({re.escape(frame)}\\): .*; nothing written")
+        if failing != expected or not 0 <= failing < len(sizes):
+            sys.exit(f"FAIL: {command}: frame {failing} failed, expected {expected} (frame sizes {sizes}):\n"
+                     f"{p.stderr}")
+        if p.returncode != 2 or not lines or not re.fullmatch(want, lines[-1]) or VTK_TEXT.search(p.stderr):
+            sys.exit(f"FAIL: {command} series past the file size limit {limit} (frame sizes {sizes}): exit "
+                     f"{p.returncode}, stderr:\n{p.stderr}\nexpected the last line to match {want!r}")
+        after = {name: open(os.path.join(folder, name), "rb").read() for name in tree(folder)}
+        if after != before:
+            changed = sorted(set(before) ^ set(after) | {n for n in before if after.get(n) != before[n]})
+            sys.exit(f"FAIL: {command}: the earlier series changed or files were left: {changed[:10]}")
+        print(f"{command}: frame {failing} over {limit} bytes refused, the earlier series kept")
+
+
+def check_hyperfun_strict(ictk, work, data):
+    """--strict (before or after the command) refuses ICTK's own library functions in a model file
+    with the diagnostic at the call, and reads HyperFun-ordered calls; without it, ICTK reads both."""
+    models = os.path.join(data, "Models")
+    blend = os.path.join(models, "stb_cross_disks.hf")
+    out = os.path.join(work, "x.vti")
+    for args in (["--strict", "sample", blend], ["sample", blend, "--strict"]):
+        p = run(ictk, args + ["--time", "0.5", "--resolution", "8", "-o", out], check=False)
+        lines = p.stderr.splitlines()
+        want = (re.escape(blend) + r":14:21: error: 'hfSpaceTimeBlend' is ICTK's own, not in HyperFun's "
+                r"library \(refused by --strict\)")
+        if p.returncode != 2 or not lines or not re.fullmatch(want, lines[0]) or os.path.exists(out):
+            sys.exit(f"FAIL: ictk {' '.join(args)}: exit {p.returncode}, stderr:\n{p.stderr}\nexpected {want!r}")
+    run(ictk, ["sample", blend, "--time", "0.5", "--resolution", "8", "-o", out])
+    # functions.hf calls bead, defined before my_model, as HyperFun requires.
+    run(ictk, ["--strict", "sample", os.path.join(models, "functions.hf"), "--params", "0,1",
+               "--resolution", "8", "-o", out])
+
+
+def run_with_fault(ictk, args, shim, path, after, fault):
+    """ictk with ictkFaultRead striking `path` (absolute) once a read passes byte `after`."""
+    env = dict(os.environ)
+    env["LD_PRELOAD"] = " ".join(filter(None, [env.get("LD_PRELOAD", ""), shim]))
+    env.update(ICTK_FAULT_PATH=path, ICTK_FAULT_AFTER=str(after), ICTK_FAULT=fault)
+    return subprocess.run([ictk] + args, capture_output=True, text=True, timeout=100, env=env)
+
+
+def check_vanishing_files(ictk, work, data, shim):
+    """A model file, a complex's voxel file and an .icm's mesh file each cut short (truncate) or
+    gone with its disk (vanish) half-way through being read: exit 2, the first line a diagnostic
+    naming the file and what happened, none of VTK's text, no output, the earlier output kept."""
+    earlier = b"the user's earlier result"
+    # A HyperFun model (read whole by readSourceFile).
+    model = os.path.join(work, "torus.hf")
+    with open(os.path.join(data, "Models", "twisted_torus.hf"), "rb") as f:
+        write(model, f.read())
+    size = os.path.getsize(model)
+    # A voxel file of a complex (read by VTK's XML reader under ictk's error capture).
+    scan = os.path.join(work, "scan.vti")
+    run(ictk, ["sample", "sphere", "-o", scan, "--resolution", "40"])
+    with open(os.path.join(work, "complex.json"), "w") as f:
+        f.write('{ "cells": [\n  { "name": "scan", "kind": "V", "dimension": 3, "file": "scan.vti" } ] }\n')
+    # The mesh file of an .icm B-cell: cut at a line boundary, what is left is itself a smaller
+    # valid mesh, which only the size check tells from the file.
+    mesh = os.path.join(work, "handle.obj")
+    lines = [f"v {math.cos(k * 0.1):.6f} {math.sin(k * 0.1):.6f} {z}" for z in (0, 1) for k in range(63)]
+    lines += [f"f {k + 1} {(k + 1) % 63 + 1} {k + 64}" for k in range(63)]
+    write(mesh, ("\n".join(lines) + "\n").encode())
+    cut = ("\n".join(lines[:126 + 40]) + "\n").encode()  # every vertex, 40 of the 63 faces
+    with open(os.path.join(work, "handle.icm"), "w") as f:
+        f.write("name = HANDLE;\nTIMESPANS { film : TIMESPAN(0, 1); }\n"
+                "CELLS {\n  Handle { type = B-CELL; shape = file(\"handle.obj\"); dim = 2D; }\n}\n"
+                "K { CELLS { Handle; } }\n")
+    cases = [
+        (model, ["sample", model, "--resolution", "16", "-o"], "out.vti", size // 2,
+         re.escape(model) + r": error: the file changed while it was read: it had " + str(size) +
+         " bytes when opened, " + str(size // 2) + " were read",
+         re.escape(model) + r": error: cannot read the file: Input/output error"),
+        (scan, ["mesh", os.path.join(work, "complex.json"), "-o"], "out.vtpc", os.path.getsize(scan) // 2,
+         re.escape(os.path.join(work, "complex.json") + ":2:13: error: cell 'scan': cannot read '" + scan +
+                   "': ") + r"its data is cut short or corrupt.*",
+         re.escape(os.path.join(work, "complex.json") + ":2:13: error: cell 'scan': cannot read '" + scan +
+                   "': ") + r".*"),
+        (mesh, ["run", os.path.join(work, "handle.icm"), "--frames", "0:1:0.5", "-o"], "out.pvd", len(cut),
+         ".*" + re.escape(mesh) + r".*the file changed while it was read: it had " +
+         str(os.path.getsize(mesh)) + " bytes when opened, " + str(len(cut)) + " were read",
+         ".*" + re.escape(mesh) + r".*cannot read the file: Input/output error"),
+    ]
+    keep = {"torus.hf", "scan.vti", "complex.json", "handle.obj", "handle.icm"}
+    for path, args, output, after, truncated, vanished in cases:
+        with open(path, "rb") as f:
+            original = f.read()
+        for fault, want in (("truncate", truncated), ("vanish", vanished)):
+            target = os.path.join(work, output)
+            write(target, earlier)
+            p = run_with_fault(ictk, args + [target], shim, path, after, fault)
+            lines = p.stderr.strip().splitlines()
+            if p.returncode != 2 or not lines or not re.fullmatch(want, lines[0]) or VTK_TEXT.search(p.stderr):
+                sys.exit(f"FAIL: {os.path.basename(path)} {fault} while read: exit {p.returncode}, stderr:\n"
+                         f"{p.stderr}\nexpected the first line to match {want!r}")
+            with open(target, "rb") as f:
+                if f.read() != earlier:
+                    sys.exit(f"FAIL: {os.path.basename(path)} {fault}: the earlier {output} was changed")
+            left = sorted(set(os.listdir(work)) - keep - {output})
+            if left:
+                sys.exit(f"FAIL: {os.path.basename(path)} {fault}: files left behind: {left}")
+            if fault == "truncate" and os.path.getsize(path) != after:
+                sys.exit(f"FAIL: the fault did not strike {path} ({os.path.getsize(path)} bytes)")
+            write(path, original)
+            os.remove(target)
+        print(f"{os.path.basename(path)}: cut at byte {after} and gone: refused")
+
+
 def vtk_id_list():
     import vtk
     return vtk.vtkIdList()
@@ -310,6 +486,12 @@ def main():
         check_mesh_2d(ictk, work, rest[0])
     elif check == "faults":
         check_faults(ictk, work, rest[0])
+    elif check == "hyperfun-strict":
+        check_hyperfun_strict(ictk, work, rest[0])
+    elif check == "vanishing-files":
+        check_vanishing_files(ictk, work, rest[0], rest[1])
+    elif check == "series-faults":
+        check_series_faults(ictk, work, rest[0])
     elif check.startswith("determinism-"):
         check_determinism(ictk, work, check[len("determinism-"):], rest[0], rest[1:])
     else:

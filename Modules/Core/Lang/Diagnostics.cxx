@@ -1,9 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Lang/Diagnostics.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
-#include <fstream>
 
 namespace ictk::lang
 {
@@ -66,27 +70,74 @@ std::string readSourceFile(const std::string& path, const Limits& limits)
     d.message = message;
     return ParseError({ d });
   };
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
+  auto tooLarge = [&](std::uint64_t size)
+  {
+    return fail("the file is too large: " + std::to_string(size) +
+      " bytes, more than the limit of " + std::to_string(limits.maxFileBytes));
+  };
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0)
   {
     throw fail("cannot open the file: " + std::string(std::strerror(errno)));
   }
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0)
+  struct Closer
   {
-    throw fail("cannot read the file");
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{ fd };
+  struct stat st
+  {};
+  if (::fstat(fd, &st) != 0)
+  {
+    throw fail("cannot read the file: " + std::string(std::strerror(errno)));
   }
-  if (static_cast<std::uint64_t>(size) > limits.maxFileBytes)
+  // A regular file's size is known before reading (and a file over the limit costs nothing); a
+  // pipe or a /proc file is read to its end, up to the limit.
+  const bool regular = S_ISREG(st.st_mode);
+  const auto opened = static_cast<std::uint64_t>(st.st_size);
+  if (regular && opened > limits.maxFileBytes)
   {
-    throw fail("the file is too large: " + std::to_string(size) +
-      " bytes, more than the limit of " + std::to_string(limits.maxFileBytes));
+    throw tooLarge(opened);
   }
-  in.seekg(0, std::ios::beg);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  if (size > 0 && !in.read(text.data(), size))
+  std::string text(regular ? static_cast<std::size_t>(opened) : std::size_t(0), '\0');
+  std::size_t done = 0;
+  for (;;)
   {
-    throw fail("cannot read the file");
+    if (done == text.size())
+    {
+      if (done > limits.maxFileBytes)
+      {
+        throw tooLarge(done);
+      }
+      // One byte past the size at opening tells a file that grew from one read to its end.
+      text.resize(done + (regular ? 1 : 65536));
+    }
+    const ssize_t n = ::read(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (n < 0)
+    {
+      throw fail("cannot read the file: " + std::string(std::strerror(errno)));
+    }
+    if (n == 0)
+    {
+      break;
+    }
+    done += static_cast<std::size_t>(n);
+    if (regular && done > opened)
+    {
+      break; // it grew: refused below
+    }
+  }
+  text.resize(done);
+  // Another program replacing or cutting the file while it is read (a copy in progress, an
+  // editor saving) would give a text that was never the file's: refused rather than half-read.
+  if (regular && done != opened)
+  {
+    throw fail("the file changed while it was read: it had " + std::to_string(opened) +
+      " bytes when opened, " + std::to_string(done) + " were read");
   }
   return text;
 }

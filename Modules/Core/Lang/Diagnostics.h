@@ -50,10 +50,15 @@ struct Limits
   std::size_t maxExpressionNodes = 20000000;  ///< DAG nodes created by one compilation
   std::size_t maxDiagnostics = 20;            ///< stop after this many errors
   std::size_t maxSyntaxNodes = 1000000;       ///< syntax tree nodes of one file (bounds memory)
+  /// HyperFun read as HyperFun's own interpreter reads it (`ictk --strict`): what ICTK accepts
+  /// beyond it (docs/hyperfun.md) is an error at its place.
+  bool strictHyperFun = false;
 };
 
 /// The whole text of a source file; throws ParseError naming the file when it cannot be opened
-/// or read, or is larger than limits.maxFileBytes (refused before reading, so it costs no memory).
+/// or read, is larger than limits.maxFileBytes (refused before reading, so it costs no memory),
+/// or changes while it is read (cut short or grown by another program: its size when opened
+/// and the bytes read differ). Pipes and /proc files are read to their end.
 std::string readSourceFile(const std::string& path, const Limits& limits);
 
 } // namespace ictk::lang

@@ -21,7 +21,8 @@ struct HyperFunModel
 };
 
 /// Compiles HyperFun source text; `fileName` is used in diagnostics. The model is the function
-/// named `function`, or the last function of the file when empty. With `parameterValues` the model
+/// named `function`, or when empty the one HyperFun's interpreter evaluates: `my_model`, else
+/// the file's first function. With `parameterValues` the model
 /// is specialised to them: its parameter array holds those constants, so parameters may also stand
 /// where HyperFun's library needs numbers (a radius, a centre); without, the parameters are slots
 /// (Expr::parameter) set at evaluation time, and such library arguments are an error that says so.

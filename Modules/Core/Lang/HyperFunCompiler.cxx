@@ -19,7 +19,9 @@
 #include "FRep/Operations.h"
 #include "FRep/Primitives.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace ictk::lang::hf
 {
@@ -367,12 +369,28 @@ Val Compiler::call(Frame& f, const ExprNode& n)
   const auto lib = library().find(n.name);
   if (lib != library().end())
   {
+    // ICTK's own library functions (docs/hyperfun.md), which HyperFun's interpreter lacks.
+    static const char* const ictkOwn[] = { "hfpin", "hfscrew", "hfplate", "hfgyroid",
+      "hfspacetimeblend" };
+    if (limits_.strictHyperFun &&
+      std::find(std::begin(ictkOwn), std::end(ictkOwn), n.name) != std::end(ictkOwn))
+    {
+      fail(n.line, n.column,
+        "'" + n.spelling + "' is ICTK's own, not in HyperFun's library (refused by --strict)");
+    }
     return lib->second(f, n);
   }
   for (const Function& g : p_.functions)
   {
     if (g.name == n.name)
     {
+      // HyperFun calls only the functions defined before the caller in the file.
+      if (limits_.strictHyperFun && f.fn && &g > f.fn)
+      {
+        fail(n.line, n.column,
+          "'" + g.spelling + "' is defined after '" + f.fn->spelling +
+            "': HyperFun calls only functions defined before the caller (refused by --strict)");
+      }
       return callUser(f, n, g);
     }
   }
@@ -767,7 +785,16 @@ HyperFunModel Compiler::run(const std::string& function)
     sink_.error(1, 1, "no function is defined (expected 'my_model(x[3], a[1]) { ... }')");
     return out;
   }
-  const Function* model = &p_.functions.back();
+  // HyperFun's own interpreter (hfp's -o, default my_model) evaluates `my_model`, else the
+  // file's first function.
+  const Function* model = &p_.functions.front();
+  for (const Function& g : p_.functions)
+  {
+    if (g.name == "my_model")
+    {
+      model = &g;
+    }
+  }
   if (!function.empty())
   {
     std::string wanted = function;

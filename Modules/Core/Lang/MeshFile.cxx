@@ -8,7 +8,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 
 namespace ictk::lang
@@ -179,9 +178,12 @@ complex::ExplicitGeometry readMeshFile(const std::string& path)
 {
   Reader r;
   r.path = path;
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    r.fail("cannot open the file");
+  // Read whole first, so that a file cut short or replaced while it is read is refused rather
+  // than read as a smaller mesh (readSourceFile compares its size with the bytes read). A mesh
+  // file is bounded by memory only, as the mesh made of it is.
+  Limits whole;
+  whole.maxFileBytes = std::size_t(1) << 34;
+  std::istringstream in(readSourceFile(path, whole));
   if (endsWith(path, ".off"))
     r.readOff(in);
   else if (endsWith(path, ".obj"))

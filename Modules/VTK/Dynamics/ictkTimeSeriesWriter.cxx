@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "ictkTimeSeriesWriter.h"
 #include "ictkComplexSource.h"
+#include "ictkFileWriting.h"
 #include "ictkRequest.h"
 
 #include "Lang/XmlText.h"
@@ -27,6 +28,7 @@
 #include "vtkXMLPartitionedDataSetWriter.h"
 #include "vtkXMLTableWriter.h"
 #include "vtkXMLUniformGridAMRWriter.h"
+#include "vtkXMLWriter.h"
 
 #include <nlohmann/json.hpp>
 
@@ -35,7 +37,6 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -367,15 +368,9 @@ int ictkTimeSeriesWriter::WriteSeries()
     std::ostringstream name;
     name << out.Stem << "_" << std::setw(static_cast<int>(digits)) << std::setfill('0') << frame
          << "." << writer->GetDefaultFileExtension();
-    writer->SetInputDataObject(saved);
-    writer->SetFileName((out.Staging / out.Stem / name.str()).string().c_str());
-    const int written = writer->Write();
-    writer->SetInputDataObject(nullptr);
-    if (written != 1 || writer->GetErrorCode() != 0)
-    {
-      throw std::runtime_error(
-        "cannot write frame " + std::to_string(frame) + " of '" + out.Name + "'");
-    }
+    this->WriteFrame(writer, saved, out.Staging / out.Stem / name.str(),
+      "cannot write frame " + std::to_string(frame) + " of '" + out.Name + "' (" +
+        (fs::path(out.Name).parent_path() / out.Stem / name.str()).string() + ")");
     // The shortest text that reads back as the same double.
     pvd << "    <DataSet timestep=\"" << nlohmann::json(time).dump() << "\" file=\""
         << ictk::lang::xmlAttribute(out.Stem + "/" + name.str(), "the frame file name") << "\"/>\n";
@@ -387,16 +382,60 @@ int ictkTimeSeriesWriter::WriteSeries()
     }
   }
   pvd << "  </Collection>\n</VTKFile>\n";
+  try
   {
-    std::ofstream file(out.Staging / (out.Stem + ".pvd"), std::ios::binary);
-    file << pvd.str();
-    if (!file.flush())
-    {
-      throw std::runtime_error("cannot write '" + out.Name + "'");
-    }
+    ictk::vtk::writeWholeFile((out.Staging / (out.Stem + ".pvd")).string(), pvd.str());
+  }
+  catch (const std::runtime_error& e)
+  {
+    throw std::runtime_error("cannot write '" + out.Name + "': " + e.what() + "; nothing written");
   }
   out.commit();
   return 1;
+}
+
+void ictkTimeSeriesWriter::WriteFrame(
+  vtkXMLWriterBase* writer, vtkDataObject* data, const fs::path& path, const std::string& failure)
+{
+  // A full disk fails the frame with the system's reason, and the staging folder goes (the
+  // earlier series stays): a single XML file is made in memory and written with checked writes,
+  // the pieces of a composite are first checked to fit (ictkFileWriting.h: VTK's XML writers can
+  // crash when their stream fails mid-file).
+  auto* single = vtkXMLWriter::SafeDownCast(writer);
+  if (!single)
+  {
+    const std::string why = ictk::vtk::piecesDoNotFit(data, path.parent_path().string());
+    if (!why.empty())
+    {
+      throw std::runtime_error(failure + ": " + why + "; nothing written");
+    }
+  }
+  writer->SetInputDataObject(data);
+  if (single)
+  {
+    single->WriteToOutputStringOn();
+  }
+  else
+  {
+    writer->SetFileName(path.string().c_str());
+  }
+  const int written = writer->Write();
+  writer->SetInputDataObject(nullptr);
+  if (written != 1 || writer->GetErrorCode() != 0)
+  {
+    throw std::runtime_error(failure + ": VTK's XML writer failed; nothing written");
+  }
+  if (single)
+  {
+    try
+    {
+      ictk::vtk::writeWholeFile(path.string(), single->GetOutputString());
+    }
+    catch (const std::runtime_error& e)
+    {
+      throw std::runtime_error(failure + ": " + e.what() + "; nothing written");
+    }
+  }
 }
 
 void ictkTimeSeriesWriter::PrintSelf(ostream& os, vtkIndent indent)

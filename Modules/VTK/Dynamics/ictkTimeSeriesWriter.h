@@ -23,7 +23,11 @@
  * Progress is the share of frames written; AbortExecute, on this writer or on the algorithm that
  * produces its input, cancels between frames (Write() returns 0, nothing is written, no error).
  * Errors (of the input at a time step or of the writing) are reported with vtkErrorMacro and
- * Write() returns 0. The frames are written by one process.
+ * Write() returns 0; a frame that cannot be written (a full disk, the file size limit) is named
+ * with its file: "cannot write frame 3 of 'out/disk.pvd' (out/disk/disk_0003.vtpc): File too
+ * large; nothing written". A single XML frame is made in memory and written with checked writes,
+ * a composite frame's pieces are first checked to fit (ictkFileWriting.h): VTK's XML writers can
+ * crash when their stream fails mid-file. The frames are written by one process.
  *
  * With ictkDynamicComplexSource as the input this is `ictk run` without its trace:
  *   source->SetFileName("disk.icm"); writer->SetInputConnection(source->GetOutputPort());
@@ -34,7 +38,10 @@
 #include "ictkFiltersDynamicsModule.h" // export macro
 #include "vtkAlgorithm.h"
 
-#include <string> // for std::string
+#include <filesystem> // for std::filesystem::path
+#include <string>     // for std::string
+
+class vtkXMLWriterBase;
 
 class ICTKFILTERSDYNAMICS_EXPORT ictkTimeSeriesWriter : public vtkAlgorithm
 {
@@ -98,4 +105,8 @@ private:
 
   /// The series, or 0 when cancelled; throws std::exception on an error.
   int WriteSeries();
+  /// Writes one frame's file at `path` (in the staging folder); throws std::runtime_error
+  /// "<failure>: <why>; nothing written" when it cannot.
+  void WriteFrame(vtkXMLWriterBase* writer, vtkDataObject* data, const std::filesystem::path& path,
+    const std::string& failure);
 };
