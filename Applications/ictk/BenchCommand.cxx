@@ -32,9 +32,9 @@
 //                         complex discretised at every step, time-coherent (issue 5); -full: the
 //                         same run re-meshing every cell of every frame
 //   andyhausen-film       the same over the whole film, 0 to 20 s in 200 steps (issue 20)
-//   band-csg3-512         the narrow band |f| <= 3 voxels of csg3 at 512^3 into a sparse OpenVDB
+//   vdb-band-512          the narrow band |f| <= 3 voxels of csg3 at 512^3 into a sparse OpenVDB
 //                         grid (voxel::sampleNarrowBand), dense sampleGrid of the same grid beside
-//                         it; band-csg3-1024, band-csg3-2048: the band alone (issue 20)
+//                         it; vdb-band-1024, vdb-band-2048: the band alone (issue 20)
 #include "BenchDynamics.h"
 #include "BenchPeer.h"
 #include "BenchScaling.h"
@@ -376,7 +376,7 @@ Result Csg3(int size)
 Result BandCsg3(int size, bool denseToo)
 {
   Result r;
-  r.workload = "band-csg3-" + std::to_string(size);
+  r.workload = "vdb-band-" + std::to_string(size);
   r.what = "narrow band |f| <= 3 voxels of csg3 (float) into a sparse OpenVDB grid "
            "(voxel::sampleNarrowBand)" +
     std::string(denseToo ? ", against frep::sampleGrid of the same dense grid" : "");
@@ -786,10 +786,19 @@ void PrintLine(const Result& r)
 
 bool Selected(const std::string& name);
 
-/// Whether --only names (a part of) `name`; heavy workloads run only then.
+/// Whether --only names `name` in full; heavy workloads run only then.
 bool Named(const std::string& name)
 {
-  return !Options.Only.empty() && Selected(name);
+  std::stringstream list(Options.Only);
+  std::string item;
+  while (std::getline(list, item, ','))
+  {
+    if (item == name)
+    {
+      return true;
+    }
+  }
+  return false;
 }
 
 bool Selected(const std::string& name)
@@ -1140,10 +1149,10 @@ int BenchCommand::run()
     report(Csg3(sampleSize));
   }
   // The narrow band at the dense workload's size (dense timed beside it) and at 2x; 4x only when
-  // --only names it.
+  // --only names it in full.
   for (int factor : { 1, 2, 4 })
   {
-    const std::string band = "band-csg3-" + std::to_string(sampleSize * factor);
+    const std::string band = "vdb-band-" + std::to_string(sampleSize * factor);
     if (factor < 4 ? Selected(band) : Named(band))
     {
       report(BandCsg3(sampleSize * factor, factor == 1));
@@ -1198,8 +1207,9 @@ int BenchCommand::run()
       report(std::move(r));
     }
   }
-  // The whole film, 0 to 20 s (TIMESPAN(0, 20)) in steps of 0.1 s (--quick: 1 s).
-  if (Named("andyhausen-film")) // minutes: only when --only names it
+  // The whole film, 0 to 20 s (TIMESPAN(0, 20)) in steps of 0.1 s (--quick: 1 s); minutes, so
+  // only when --only names it in full.
+  if (Named("andyhausen-film"))
   {
     for (Result& r : Andyhausen("film", 20.0, Options.Quick ? 20 : 200))
     {

@@ -483,6 +483,14 @@ def check_bench(ictk, work):
     # The plain report names the workload; an --only that matches nothing is a user error.
     if "csg3-64:" not in run(ictk, ["bench", "--quick", "--only", "csg3"]).stdout:
         sys.exit("FAIL: plain report")
+    # The narrow band beside dense sampling of the same grid (issue 20): memory and counts.
+    r = json.loads(run(ictk, ["bench", "--json", "--quick", "--only", "vdb-band-64"]).stdout)
+    if [w["workload"] for w in r] != ["vdb-band-64"]:
+        sys.exit(f"FAIL: vdb-band workloads: {r}")
+    d = r[0]["details"]
+    if not (0 < d["active_voxels"] < 64 ** 3 and d["grid_bytes"] > 0 and d["dense_cpu_seconds"] > 0
+            and d["dense_float_bytes"] == 4 * 64 ** 3):
+        sys.exit(f"FAIL: vdb-band-64 details: {d}")
     # The dynamic workload (issue 7): the coherent run and the full re-meshing mesh the same
     # frames (as many points), the coherent one reusing cells.
     d = {r["workload"]: r for r in json.loads(run(ictk, ["bench", "--json", "--quick", "--only", "andyhausen"]).stdout)}
