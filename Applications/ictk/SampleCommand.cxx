@@ -44,7 +44,8 @@ class SampleCommand final : public Command
 public:
   CLI::App* add(CLI::App& app) override
   {
-    CLI::App* sample = app.add_subcommand("sample", "Sample a model on a regular grid (.vti)");
+    CLI::App* sample = app.add_subcommand(
+      "sample", "Sample a model on a regular grid (.vti), or its narrow band (.vdb)");
     o.AddTo(sample, 64);
     AddOutput(sample, o.Output,
       "Output image (.vti), or a sparse OpenVDB grid of the narrow band (.vdb, see --band)");
