@@ -76,6 +76,7 @@ public:
   void write(const std::string& path, const std::string& gridName = "f") const;
 
 private:
+  NarrowBandGrid() = default; // only sampleNarrowBand makes one
   struct Impl;
   std::shared_ptr<const Impl> impl_;
   friend NarrowBandGrid sampleNarrowBand(
