@@ -31,6 +31,10 @@
 //   andyhausen-100        a 10-second, 100-step run of Data/Models/icm/andyhausen.icm with the
 //                         complex discretised at every step, time-coherent (issue 5); -full: the
 //                         same run re-meshing every cell of every frame
+//   andyhausen-film       the same over the whole film, 0 to 20 s in 200 steps (issue 20)
+//   vdb-band-512          the narrow band |f| <= 3 voxels of csg3 at 512^3 into a sparse OpenVDB
+//                         grid (voxel::sampleNarrowBand), dense sampleGrid of the same grid beside
+//                         it; vdb-band-1024, vdb-band-2048: the band alone (issue 20)
 #include "BenchDynamics.h"
 #include "BenchPeer.h"
 #include "BenchScaling.h"
@@ -54,6 +58,7 @@
 #include "Lang/VmReader.h"
 #include "Mesh/Writers.h"
 #include "Render/RayCast.h"
+#include "Voxel/NarrowBand.h"
 
 #include "ictkCsgRecipeToVtk.h"
 
@@ -364,6 +369,59 @@ Result Csg3(int size)
   return r;
 }
 
+// --- narrow band into a sparse OpenVDB grid ------------------------------------------------------
+
+/// voxel::sampleNarrowBand of csg3 at size^3 (band: 3 voxels), with the dense sampling of the same
+/// grid timed beside it when it fits (`denseToo`): memory follows the surface, not the volume.
+Result BandCsg3(int size, bool denseToo)
+{
+  Result r;
+  r.workload = "vdb-band-" + std::to_string(size);
+  r.what = "narrow band |f| <= 3 voxels of csg3 (float) into a sparse OpenVDB grid "
+           "(voxel::sampleNarrowBand)" +
+    std::string(denseToo ? ", against frep::sampleGrid of the same dense grid" : "");
+  r.threads = ThreadsOr(2);
+  r.unit = "Mvoxels/s";
+  const frep::ModelInfo& info = frep::findModel("csg3");
+  const frep::TapePtr tape = frep::Tape::compile(info.build().geometry().function());
+  const frep::Grid grid = frep::gridOverBox(info.boundsLo, info.boundsHi, { size, size, size });
+  voxel::NarrowBandOptions options;
+  options.threads = r.threads;
+  std::optional<voxel::NarrowBandGrid> band;
+  // Large grids: fewer runs (one at 2048^3 takes seconds).
+  const int runs = size >= 2048 ? 1 : size >= 1024 ? std::min(Options.Runs, 3) : Options.Runs;
+  r.allSeconds = Time(
+    runs, [&] { band = voxel::sampleNarrowBand(tape, grid, options); }, &r.cpuSeconds);
+  r.seconds = Median(r.allSeconds);
+  const auto active = static_cast<double>(band->activeVoxelCount());
+  r.work = active;
+  const double denseBytes = 4.0 * static_cast<double>(grid.pointCount());
+  r.details["active_voxels"] = band->activeVoxelCount();
+  r.details["band"] = band->band();
+  r.details["grid_bytes"] = band->memoryBytes();
+  // Bytes per active voxel, which is also MB per million active voxels.
+  r.details["mb_per_million_active_voxels"] = static_cast<double>(band->memoryBytes()) / active;
+  r.details["dense_float_bytes"] = denseBytes;
+  r.details["memory_over_dense"] = static_cast<double>(band->memoryBytes()) / denseBytes;
+  r.details["leaves_sampled"] = band->stats().leavesSampled;
+  r.details["leaves_kept"] = band->stats().leavesKept;
+  r.details["interval_evaluations"] = band->stats().intervalEvaluations;
+  band.reset();
+  if (denseToo)
+  {
+    std::vector<float> out(static_cast<std::size_t>(grid.pointCount()));
+    frep::SampleOptions dense;
+    dense.threads = r.threads;
+    std::vector<double> denseCpu;
+    const std::vector<double> denseRuns = Time(
+      runs, [&] { frep::sampleGrid(tape, grid, out.data(), dense); }, &denseCpu);
+    r.details["dense_seconds"] = Median(denseRuns);
+    r.details["dense_cpu_seconds"] = Median(denseCpu);
+    r.details["dense_over_band_cpu"] = Median(denseCpu) / Median(r.cpuSeconds);
+  }
+  return r;
+}
+
 // --- output -------------------------------------------------------------------------------------
 
 /// Times `mesh` (Options.Runs runs after a warm-up) into r, with the triangle count and the
@@ -607,8 +665,9 @@ Result TRexMesh(double featureSize)
   return r;
 }
 
-/// The coherent run and the full re-meshing of the same frames, as two workloads.
-std::vector<Result> Andyhausen(int steps)
+/// The coherent run and the full re-meshing of the same frames, as two workloads: 0 to `t1` s in
+/// `steps` steps, named andyhausen-`name`[-full].
+std::vector<Result> Andyhausen(const std::string& name, double t1, int steps)
 {
   const std::string path = std::string(ICTK_DATA_DIR) + "/Models/icm/andyhausen.icm";
   const int threads = ThreadsOr(2);
@@ -617,16 +676,18 @@ std::vector<Result> Andyhausen(int steps)
   // the full re-meshing to stay under a minute a run.
   const int divisions = 128;
   const DynamicRunTiming coherent =
-    TimeDynamicRun(path, 10.0, steps, divisions, true, Options.Runs, threads);
+    TimeDynamicRun(path, t1, steps, divisions, true, Options.Runs, threads);
   const DynamicRunTiming full =
-    TimeDynamicRun(path, 10.0, steps, divisions, false, Options.Runs, threads);
+    TimeDynamicRun(path, t1, steps, divisions, false, Options.Runs, threads);
   std::vector<Result> results;
   for (const DynamicRunTiming* timing : { &coherent, &full })
   {
     Result r;
     const bool isFull = timing == &full;
-    r.workload = "andyhausen-" + std::to_string(steps) + (isFull ? "-full" : "");
-    r.what = "a 10-second, " + std::to_string(steps) +
+    r.workload = "andyhausen-" + name + (isFull ? "-full" : "");
+    std::ostringstream seconds;
+    seconds << t1;
+    r.what = "a " + seconds.str() + "-second, " + std::to_string(steps) +
       "-step run of the Andyhausen model, the complex discretised at every step at 1/128 of "
       "its size" +
       (isFull ? ", every cell re-meshed" : ", time-coherent");
@@ -721,6 +782,23 @@ void PrintLine(const Result& r)
        << "x VTK: " << (*r.vtkSeconds / r.seconds >= *r.goalRatio ? "met" : "missed");
   }
   std::cout << os.str() << "\n" << std::flush;
+}
+
+bool Selected(const std::string& name);
+
+/// Whether --only names `name` in full; heavy workloads run only then.
+bool Named(const std::string& name)
+{
+  std::stringstream list(Options.Only);
+  std::string item;
+  while (std::getline(list, item, ','))
+  {
+    if (item == name)
+    {
+      return true;
+    }
+  }
+  return false;
 }
 
 bool Selected(const std::string& name)
@@ -1005,6 +1083,10 @@ CLI::App* BenchCommand::add(CLI::App& app)
 int BenchCommand::run()
 {
   CheckThreads(Options.Threads);
+  if (ScalePointRequested())
+  {
+    return RunScalePoint(Options.Threads);
+  }
   if (ScalingRequested())
   {
     return RunScalingBench(Options.Runs, Options.Threads, Options.Json, Options.Quick);
@@ -1066,6 +1148,16 @@ int BenchCommand::run()
   {
     report(Csg3(sampleSize));
   }
+  // The narrow band at the dense workload's size (dense timed beside it) and at 2x; 4x only when
+  // --only names it in full.
+  for (int factor : { 1, 2, 4 })
+  {
+    const std::string band = "vdb-band-" + std::to_string(sampleSize * factor);
+    if (factor < 4 ? Selected(band) : Named(band))
+    {
+      report(BandCsg3(sampleSize * factor, factor == 1));
+    }
+  }
   const double gyroidSize = Options.Quick ? 0.1 : 0.025;
   std::ostringstream gyroidName;
   gyroidName << "sphere-gyroid-" << gyroidSize;
@@ -1110,7 +1202,16 @@ int BenchCommand::run()
   const std::string andyhausen = "andyhausen-" + std::to_string(andyhausenSteps);
   if (Selected(andyhausen) || Selected(andyhausen + "-full"))
   {
-    for (Result& r : Andyhausen(andyhausenSteps))
+    for (Result& r : Andyhausen(std::to_string(andyhausenSteps), 10.0, andyhausenSteps))
+    {
+      report(std::move(r));
+    }
+  }
+  // The whole film, 0 to 20 s (TIMESPAN(0, 20)) in steps of 0.1 s (--quick: 1 s); minutes, so
+  // only when --only names it in full.
+  if (Named("andyhausen-film"))
+  {
+    for (Result& r : Andyhausen("film", 20.0, Options.Quick ? 20 : 200))
     {
       report(std::move(r));
     }

@@ -9,6 +9,8 @@
 // the contourer asks for. Pruned work should grow with the surface (r^2 in 3D, r in 2D), not with
 // the volume.
 #include "BenchScaling.h"
+#include "BenchDynamics.h"
+#include "Command.h"
 #include "ProgressDisplay.h"
 
 #include "Discretize/Surface.h"
@@ -16,14 +18,20 @@
 #include "FRep/Field.h"
 #include "FRep/Render.h"
 #include "FRep/Sampling.h"
+#include "Voxel/NarrowBand.h"
 
 #include <nlohmann/json.hpp>
+
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <ctime>
+#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <iostream>
@@ -32,6 +40,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <unistd.h>
 
 namespace ictk::cli
 {
@@ -42,6 +52,7 @@ namespace frep = ictk::frep;
 namespace bundled = ictk::frep::bundled;
 
 bool Scaling = false;
+std::string ScalePoint; // --scale-point KIND=VALUE
 // Primitive counts of the model-size table: about 100, 1k, 10k and 100k tape instructions.
 std::vector<int> PrimitiveCounts{ 6, 62, 628, 7940 };
 constexpr std::uint32_t ScalingSeed = 20240611u; // random1000's seed
@@ -474,6 +485,165 @@ std::vector<Table> ResolutionTables(const std::vector<int>& sampleSizes,
   }
   return { sampling, occupancy, render, contour };
 }
+
+// --- one point of Scripts/scale-plots ------------------------------------------------------------
+
+/// The process's resident set now (bytes), from /proc/self/statm.
+double ResidentBytes()
+{
+  std::ifstream statm("/proc/self/statm");
+  double size = 0, resident = 0;
+  statm >> size >> resident;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
+
+double PeakResidentBytes()
+{
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) * 1024.0; // Linux: kilobytes
+}
+
+/// Runs `f` once and returns its wall and CPU seconds with the memory figures.
+nlohmann::json MeasureOnce(const std::function<void(nlohmann::json&)>& f)
+{
+  nlohmann::json j;
+  j["rss_before_bytes"] = ResidentBytes();
+  const double c0 = CpuSeconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  f(j);
+  j["wall_seconds"] = Seconds(t0);
+  j["cpu_seconds"] = CpuSeconds() - c0;
+  j["peak_rss_bytes"] = PeakResidentBytes();
+  return j;
+}
+
+int RunScalePointNow(int threads)
+{
+  const std::size_t eq = ScalePoint.find('=');
+  if (eq == std::string::npos)
+  {
+    throw UserError("--scale-point: expected KIND=VALUE, got '" + ScalePoint + "'");
+  }
+  const std::string kind = ScalePoint.substr(0, eq);
+  char* end = nullptr;
+  const std::string number = ScalePoint.substr(eq + 1);
+  const double value = std::strtod(number.c_str(), &end);
+  if (number.empty() || *end != '\0' || !(value > 0) || !std::isfinite(value))
+  {
+    throw UserError("--scale-point: the value of '" + ScalePoint + "' is not a positive number");
+  }
+  const auto resolution = static_cast<std::int64_t>(value);
+  nlohmann::json j;
+  if (kind == "sample-dense" || kind == "sample-band")
+  {
+    const frep::TapePtr tape = frep::Tape::compile(bundled::csgField(bundled::random1000Recipe()));
+    const frep::Grid grid =
+      frep::gridOverBox(ModelBox.lo, ModelBox.hi, { resolution, resolution, resolution });
+    if (kind == "sample-dense")
+    {
+      j = MeasureOnce(
+        [&](nlohmann::json& out)
+        {
+          std::vector<float> values(static_cast<std::size_t>(grid.pointCount()));
+          frep::SampleOptions options;
+          options.threads = threads;
+          frep::sampleGrid(tape, grid, values.data(), options);
+          out["values_bytes"] = values.size() * sizeof(float);
+        });
+    }
+    else
+    {
+      j = MeasureOnce(
+        [&](nlohmann::json& out)
+        {
+          voxel::NarrowBandOptions options;
+          options.threads = threads;
+          const voxel::NarrowBandGrid band = voxel::sampleNarrowBand(tape, grid, options);
+          out["active_voxels"] = band.activeVoxelCount();
+          out["grid_bytes"] = band.memoryBytes();
+          out["band"] = band.band();
+          out["leaves_sampled"] = band.stats().leavesSampled;
+          out["leaves_kept"] = band.stats().leavesKept;
+          out["interval_evaluations"] = band.stats().intervalEvaluations;
+        });
+    }
+    j["points"] = grid.pointCount();
+    j["tape_instructions"] = tape->instructions().size();
+  }
+  else if (kind == "contour")
+  {
+    const frep::TapePtr tape = frep::Tape::compile(bundled::csgField(bundled::random1000Recipe()));
+    const frep::FieldPtr field = frep::tapeField(tape);
+    j = MeasureOnce(
+      [&](nlohmann::json& out)
+      {
+        discretize::SurfaceOptions options;
+        options.featureSize = value;
+        options.threads = threads;
+        const discretize::SurfaceMesh mesh = discretize::contourSurface(*field, ModelBox, options);
+        out["triangles"] = mesh.triangles.size();
+        out["vertices"] = mesh.points.size();
+      });
+    j["cells_per_axis"] = std::ceil(2 * BoxHalf / value);
+  }
+  else if (kind == "primitives")
+  {
+    const int primitives = static_cast<int>(value);
+    const double c0 = CpuSeconds();
+    const frep::TapePtr tape = RandomCsgTape(primitives);
+    const double compileSeconds = CpuSeconds() - c0;
+    constexpr int Size = 1024;
+    j = MeasureOnce(
+      [&](nlohmann::json& out)
+      {
+        frep::RenderRegion region;
+        region.lo = { -BoxHalf, -BoxHalf, 0.0 };
+        region.hi = { BoxHalf, BoxHalf, 0.0 };
+        frep::RenderOptions options;
+        options.threads = threads;
+        frep::RenderStats stats;
+        options.stats = &stats;
+        const std::vector<std::uint8_t> image =
+          frep::renderSign2D(tape, region, Size, Size, options);
+        out["pixels_evaluated"] = stats.pixelsEvaluated;
+        out["leaf_tiles"] = stats.tilesEvaluated;
+        out["leaf_instructions"] = stats.leafInstructions;
+      });
+    j["pixels"] = Size * Size;
+    j["compile_cpu_seconds"] = compileSeconds;
+    j["tape_instructions"] = tape->instructions().size();
+    j["choices"] = tape->choiceCount();
+  }
+  else if (kind == "frames" || kind == "frames-full")
+  {
+    // The Andyhausen film from its start, one frame per 0.1 s, meshed at 1/48 of its size.
+    const int steps = static_cast<int>(value);
+    const std::string path = std::string(ICTK_DATA_DIR) + "/Models/icm/andyhausen.icm";
+    DynamicRunTiming timing;
+    j = MeasureOnce(
+      [&](nlohmann::json& out)
+      {
+        timing = TimeDynamicRun(path, 0.1 * steps, steps, 48, kind == "frames", 1, threads);
+        out["mesh_seconds"] = timing.meshSeconds;
+        out["points"] = timing.points;
+        out["cells_computed"] = timing.computed;
+        out["cells_moved"] = timing.moved;
+        out["cells_reused"] = timing.reused;
+      });
+    j["frames"] = timing.frames;
+  }
+  else
+  {
+    throw UserError("--scale-point: unknown kind '" + kind +
+      "' (sample-dense, sample-band, contour, primitives, frames, frames-full)");
+  }
+  j["kind"] = kind;
+  j["value"] = value;
+  j["threads"] = threads;
+  std::cout << j.dump() << "\n";
+  return 0;
+}
 } // namespace
 
 void AddScalingOptions(CLI::App& bench)
@@ -485,6 +655,22 @@ void AddScalingOptions(CLI::App& bench)
   bench.add_option("--scaling-primitives", PrimitiveCounts,
     "Primitive counts of the model-size table (default 6 62 628 7940: 99, 1016, 10019, 100161 "
     "instructions)");
+  bench.add_option("--scale-point", ScalePoint,
+    "One measurement for Scripts/scale-plots, run once in this process and printed as one JSON "
+    "line with its CPU time and the process's peak RSS: sample-dense=R, sample-band=R (random1000 "
+    "at R^3, dense or narrow band), contour=FEATURE_SIZE, primitives=N (pruned 1024^2 render of a "
+    "random CSG of N primitives), frames=N or frames-full=N (the Andyhausen film over N frames "
+    "of 0.1 s, coherent or re-meshed); 1 thread unless --threads");
+}
+
+bool ScalePointRequested()
+{
+  return !ScalePoint.empty();
+}
+
+int RunScalePoint(int threads)
+{
+  return RunScalePointNow(threads > 0 ? threads : 1);
 }
 
 bool ScalingRequested()

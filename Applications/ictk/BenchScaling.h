@@ -13,6 +13,11 @@ namespace ictk::cli
 void AddScalingOptions(CLI::App& bench);
 /// True when --scaling was given.
 bool ScalingRequested();
+/// True when --scale-point was given.
+bool ScalePointRequested();
+/// Runs the one measurement --scale-point names and prints it as one JSON line; returns the exit
+/// code. `threads` 0 means 1 thread.
+int RunScalePoint(int threads);
 /// Prints the scaling tables (or JSON); returns the exit code. `threads` 0 means 1 thread.
 int RunScalingBench(int runs, int threads, bool json, bool quick);
 

@@ -11,6 +11,7 @@ Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
 "@WORK@" in ICTK-ARGS is replaced by the work folder.
 """
+import csv
 import json
 import math
 import os
@@ -141,6 +142,50 @@ def check_sample_sphere(ictk, work):
     if read_image(vti).GetPointData().GetArray("f").GetDataType() != 11:  # VTK_DOUBLE
         sys.exit("FAIL: --double did not write doubles")
     no_leftovers(work)
+
+
+def check_sample_band(ictk, work):
+    # `ictk sample -o x.vdb` (voxel::sampleNarrowBand): the sphere model f = 1 - r^2 with band 0.1
+    # keeps the points with 0.9 <= r^2 <= 1.1, a shell of volume 4/3 pi (1.1^1.5 - 0.9^1.5).
+    vdb = os.path.join(work, "band.vdb")
+    p = run(ictk, ["sample", "sphere", "-o", vdb, "--bounds", "-1.2,1.2,-1.2,1.2,-1.2,1.2",
+                   "--resolution", "97", "--band", "0.1", "--threads", "2"])
+    m = re.search(r"narrow band \|f\| <= 0.1 of 97 x 97 x 97 points: (\d+) active voxels", p.stdout)
+    if not m:
+        sys.exit(f"FAIL: no active voxel count in:\n{p.stdout}")
+    h = 2.4 / 96
+    shell = 4 / 3 * math.pi * (1.1 ** 1.5 - 0.9 ** 1.5) / h ** 3
+    near(int(m.group(1)) / shell, 1.0, 0.03, "active voxels over the shell's volume in voxels")
+    with open(vdb, "rb") as f:
+        if f.read(4) != b" BDV":  # OpenVDB's magic number, little-endian
+            sys.exit("FAIL: the .vdb does not start with OpenVDB's magic number")
+    no_leftovers(work)
+    # A point of Scripts/scale-plots: one JSON line.
+    point = json.loads(run(ictk, ["bench", "--scale-point", "sample-band=32"]).stdout)
+    for key in ("cpu_seconds", "peak_rss_bytes", "active_voxels", "grid_bytes"):
+        if not point.get(key, 0) > 0:
+            sys.exit(f"FAIL: --scale-point sample-band=32: {key} missing or not positive: {point}")
+
+
+def check_scale_plots(ictk, work, script):
+    # Scripts/scale-plots --quick: every kind measured twice, the CSV and the four plots written.
+    run_command = [script, "--ictk", ictk, "--out", work, "--quick"]
+    p = subprocess.run(run_command, capture_output=True, text=True, timeout=600)
+    if p.returncode != 0:
+        sys.exit(f"FAIL: {run_command} exited {p.returncode}:\n{p.stdout}\n{p.stderr}")
+    with open(os.path.join(work, "scale.csv")) as f:
+        rows = list(csv.DictReader(f))
+    kinds = sorted({r["kind"] for r in rows})
+    if len(rows) != 14 or kinds != ["contour", "frames", "frames-full", "primitives", "sample-band",
+                                    "sample-dense", "tets"]:
+        sys.exit(f"FAIL: scale.csv rows {len(rows)}, kinds {kinds}")
+    for r in rows:
+        if not (float(r["cpu_seconds"]) > 0 and float(r["peak_rss_mib"]) > 1):
+            sys.exit(f"FAIL: scale.csv row without CPU time or memory: {r}")
+    for name in ("resolution", "primitives", "tets", "frames"):
+        path = os.path.join(work, f"scale-{name}.png")
+        if not os.path.isfile(path) or os.path.getsize(path) < 10000:
+            sys.exit(f"FAIL: {path} missing or too small")
 
 
 def check_sample_walnut(ictk, work):
@@ -438,6 +483,14 @@ def check_bench(ictk, work):
     # The plain report names the workload; an --only that matches nothing is a user error.
     if "csg3-64:" not in run(ictk, ["bench", "--quick", "--only", "csg3"]).stdout:
         sys.exit("FAIL: plain report")
+    # The narrow band beside dense sampling of the same grid (issue 20): memory and counts.
+    r = json.loads(run(ictk, ["bench", "--json", "--quick", "--only", "vdb-band-64"]).stdout)
+    if [w["workload"] for w in r] != ["vdb-band-64"]:
+        sys.exit(f"FAIL: vdb-band workloads: {r}")
+    d = r[0]["details"]
+    if not (0 < d["active_voxels"] < 64 ** 3 and d["grid_bytes"] > 0 and d["dense_cpu_seconds"] > 0
+            and d["dense_float_bytes"] == 4 * 64 ** 3):
+        sys.exit(f"FAIL: vdb-band-64 details: {d}")
     # The dynamic workload (issue 7): the coherent run and the full re-meshing mesh the same
     # frames (as many points), the coherent one reusing cells.
     d = {r["workload"]: r for r in json.loads(run(ictk, ["bench", "--json", "--quick", "--only", "andyhausen"]).stdout)}
@@ -1167,6 +1220,7 @@ def main():
         "eval-json": check_eval_json,
         "eval-plain": check_eval_plain,
         "sample-sphere": check_sample_sphere,
+        "sample-band": check_sample_band,
         "sample-walnut": check_sample_walnut,
         "sample-disk2d": check_sample_disk2d,
         "mesh-formats": check_mesh_formats,
@@ -1183,6 +1237,10 @@ def main():
         return
     if check == "study-implants":
         check_study_implants(ictk, work, rest[0])
+        print("OK")
+        return
+    if check == "scale-plots":
+        check_scale_plots(ictk, work, rest[0])
         print("OK")
         return
     if check == "tetra-bar":

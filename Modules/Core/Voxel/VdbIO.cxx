@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Voxel/VdbIO.h"
+#include "Voxel/VdbDetail.h"
 
 #include "FRep/Sampling.h"
 
@@ -22,12 +23,6 @@ namespace
 {
 
 namespace fs = std::filesystem;
-
-void initialiseOpenVdb()
-{
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
 
 std::string inQuotes(const std::string& s)
 {
@@ -83,7 +78,7 @@ std::shared_ptr<VoxelGrid> readVdb(
   {
     throw std::runtime_error(where + ": is a folder, not an OpenVDB file");
   }
-  initialiseOpenVdb();
+  detail::initialiseOpenVdb();
 
   openvdb::io::File file(path);
   std::vector<std::pair<std::string, std::string>> grids;
@@ -266,24 +261,11 @@ void writeVdb(const VoxelGrid& grid, const std::string& path, const std::string&
       throw std::invalid_argument(where + ": too many points along an axis for OpenVDB");
     }
   }
-  initialiseOpenVdb();
+  detail::initialiseOpenVdb();
 
   openvdb::FloatGrid::Ptr vdb = openvdb::FloatGrid::create(bg);
   vdb->setName(gridName);
-  openvdb::math::Transform::Ptr xf;
-  const openvdb::Vec3d origin(grid.origin[0], grid.origin[1], grid.origin[2]);
-  if (grid.spacing[0] == grid.spacing[1] && grid.spacing[1] == grid.spacing[2])
-  {
-    xf = openvdb::math::Transform::createLinearTransform(grid.spacing[0]);
-    xf->postTranslate(origin);
-  }
-  else
-  {
-    const openvdb::Vec3d spacing(grid.spacing[0], grid.spacing[1], grid.spacing[2]);
-    xf = std::make_shared<openvdb::math::Transform>(
-      std::make_shared<openvdb::math::ScaleTranslateMap>(spacing, origin));
-  }
-  vdb->setTransform(xf);
+  vdb->setTransform(detail::gridTransform(grid.origin, grid.spacing));
   const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0),
     openvdb::Coord(static_cast<openvdb::Int32>(grid.dimensions[0] - 1),
       static_cast<openvdb::Int32>(grid.dimensions[1] - 1),
@@ -293,6 +275,36 @@ void writeVdb(const VoxelGrid& grid, const std::string& path, const std::string&
     box, const_cast<float*>(grid.values.data()));
   openvdb::tools::copyFromDense(dense, *vdb, -1.0f);
 
+  detail::writeAtomically(vdb, path, where);
+}
+
+namespace detail
+{
+
+void initialiseOpenVdb()
+{
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+openvdb::math::Transform::Ptr gridTransform(
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing)
+{
+  const openvdb::Vec3d o(origin[0], origin[1], origin[2]);
+  if (spacing[0] == spacing[1] && spacing[1] == spacing[2])
+  {
+    openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(spacing[0]);
+    xf->postTranslate(o);
+    return xf;
+  }
+  const openvdb::Vec3d s(spacing[0], spacing[1], spacing[2]);
+  return std::make_shared<openvdb::math::Transform>(
+    std::make_shared<openvdb::math::ScaleTranslateMap>(s, o));
+}
+
+void writeAtomically(
+  const openvdb::GridBase::Ptr& vdb, const std::string& path, const std::string& where)
+{
   // Write next to the target, then rename over it (atomic on one file system).
   static std::atomic<unsigned> counter{ 0 };
   const fs::path target(path);
@@ -324,5 +336,7 @@ void writeVdb(const VoxelGrid& grid, const std::string& path, const std::string&
     throw std::runtime_error(where + ": cannot write the file (" + e.what() + ")");
   }
 }
+
+} // namespace detail
 
 } // namespace ictk::voxel
