@@ -414,11 +414,13 @@ void ictkComplexSource::SetComplex(std::shared_ptr<const ictk::complex::Complex>
   this->Modified();
 }
 
-complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path)
+complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path,
+  std::function<void(const std::string&, std::shared_ptr<const voxel::VoxelGrid>)> scanRead)
 {
   lang::ComplexFileReaders readers;
   readers.mesh = readMesh;
   readers.volume = readVolume;
+  readers.scanRead = std::move(scanRead);
   return lang::readComplexFile(path, {}, readers);
 }
 
