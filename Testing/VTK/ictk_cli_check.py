@@ -1112,6 +1112,19 @@ def check_study(ictk, work, data):
             t.addfile(info, io.BytesIO(payload))
     refused("short", r"'matrix\.dat' holds 14024704 bytes; its shape 108 x 256 x 256 of int16 needs 14155776",
             scan=short)
+    # The same through VTK's readers: a MetaImage and a NRRD header of 10^3 int16 values whose
+    # raw file holds 9 slices (vtkmetaio only prints this on stderr and VTK hands on zeros).
+    open(os.path.join(work, "short.raw"), "wb").write(bytes(10 * 10 * 9 * 2))
+    with open(os.path.join(work, "short.mhd"), "w") as f:
+        f.write("ObjectType = Image\nNDims = 3\nDimSize = 10 10 10\nElementType = MET_SHORT\n"
+                "ElementSpacing = 1 1 1\nOffset = 0 0 0\nElementDataFile = short.raw\n")
+    refused("short-mhd", r"short\.mhd': its data holds fewer values than its header's size says "
+            r"\(ideal = 2000 : actual = 1800 bytes\)", scan=os.path.join(work, "short.mhd"))
+    with open(os.path.join(work, "short.nhdr"), "w") as f:
+        f.write("NRRD0004\ntype: short\ndimension: 3\nsizes: 10 10 10\nspacings: 1 1 1\n"
+                "encoding: raw\nendian: little\ndata file: short.raw\n")
+    refused("short-nrrd", r"short\.nhdr': its data holds fewer values than its header's size says",
+            scan=os.path.join(work, "short.nhdr"))
     refused("outside", r"implant 'implant' reaches outside the specimen on axis z: \[140, 152\.25\]",
             implant_z0=140)
     # A 0.1 mm shell at size 1: CGAL would lose it (or never finish); refused before meshing.
