@@ -14,11 +14,12 @@
 #include "ProgressDisplay.h"
 #include "Study.h"
 
+#include "ictkComplexSource.h"
+
 #include "Mesh/Backends/Backends.h"
 #include "Mesh/Quality.h"
 #include "Mesh/ScanMaterials.h"
 #include "Mesh/Writers.h"
-#include "Voxel/VolumeFile.h"
 #include "Voxel/VoxelField.h"
 #ifdef ICTK_HAVE_MESH_CGAL
 #include "Mesh/CGAL/MeshCgal.h"
@@ -53,8 +54,6 @@ struct StudySettings
 {
   double size = 1;
   std::string scan;
-  std::string scanFile;
-  std::string scanArray;
   std::vector<std::string> implants;
   mesh::ScanMaterialOptions materials;
   /// The deck's modulus bins, in ln E (Writers.h deckMaterials).
@@ -101,18 +100,13 @@ StudySettings readSettings(const std::string& path)
   StudySettings out;
   out.size = numberAt(s, "size", 1, where);
   out.scan = s.value("scan", std::string());
-  // The scan cell's file, resolved as the complex reader resolves it.
-  for (const auto& cell : doc.value("cells", Json::array()))
-  {
-    if (cell.value("name", std::string()) == out.scan && cell.value("kind", std::string()) == "V")
-    {
-      const fs::path file = cell.value("file", std::string());
-      out.scanFile =
-        file.is_absolute() ? file.string() : (fs::path(path).parent_path() / file).string();
-      out.scanArray = cell.value("array", std::string());
-    }
-  }
-  if (out.scanFile.empty())
+  const auto cells = doc.value("cells", Json::array());
+  if (std::none_of(cells.begin(), cells.end(),
+        [&](const Json& cell)
+        {
+          return cell.value("name", std::string()) == out.scan &&
+            cell.value("kind", std::string()) == "V";
+        }))
   {
     throw UserError(where + ": \"scan\" must name a voxel (V) cell of the complex");
   }
@@ -461,7 +455,22 @@ StudyMesh MakeStudyMesh(const StudyRequest& r)
   StudyMesh out;
   const auto t0 = std::chrono::steady_clock::now();
   const StudySettings settings = readSettings(r.model);
-  const complex::Complex k = LoadComplex(r.model);
+  // The scan's Hounsfield units for the materials: the scan cell's own grid, as its field reads
+  // it (after its stamps), so the materials see what was meshed and the scan is read once.
+  std::shared_ptr<const voxel::VoxelGrid> grid;
+  const complex::Complex k = ictkComplexSource::ReadComplexFile(r.model,
+    [&](const std::string& cell, std::shared_ptr<const voxel::VoxelGrid> g)
+    {
+      if (cell == settings.scan)
+      {
+        grid = std::move(g);
+      }
+    });
+  if (!grid)
+  {
+    throw UserError("'" + r.model + "': study: \"scan\" names no voxel cell that was read ('" +
+      settings.scan + "')");
+  }
   checkImplants(k, settings);
   std::vector<std::string> cells;
   for (complex::CellId id : k.cellsOfDimension(3))
@@ -475,15 +484,6 @@ StudyMesh MakeStudyMesh(const StudyRequest& r)
   catch (const std::exception& e)
   {
     throw UserError("'" + r.model + "': study: " + e.what());
-  }
-  std::shared_ptr<voxel::VoxelGrid> grid;
-  try
-  {
-    grid = voxel::readCoreVolume(settings.scanFile, settings.scanArray);
-  }
-  catch (const std::exception& e)
-  {
-    throw UserError(std::string("study: the scan's Hounsfield units: ") + e.what());
   }
   out.readSeconds = Seconds(t0);
   // CGAL 5.5 cannot resolve two protected curves closer than about its protecting balls (the

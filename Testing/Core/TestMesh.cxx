@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -378,6 +379,31 @@ TEST(MeshWriters, MaterialsAreVolumeWeightedMeans)
   EXPECT_NEAR(materials[0].density, 7.8e-9, 1e-20);
   EXPECT_NEAR(materials[1].youngsModulus, 70000, 1e-9);
   EXPECT_NEAR(materials[1].density, 1e-9, 1e-20); // theta1: aluminium binds no density
+}
+
+// Issue 15's modulus bins leave the two-material bar as it was: its cells' moduli are constant,
+// so the default 1 % bins write the very bytes of one material per cell (an infinite bin width:
+// the deck before binning), two *MATERIAL cards and no extra element sets.
+TEST(MeshAbaqus, TwoMaterialBarDeckUnchangedByModulusBins)
+{
+  const auto k = lang::readComplexJson(ictk::testing::barJson(), "bar.json");
+  const TetMesh m = ictk::testing::barMesh(k, 20, 2);
+  const fs::path dir = scratch("bar-bins");
+  AbaqusOptions perCell;
+  perCell.modulusBinWidth = std::numeric_limits<double>::infinity();
+  writeAbaqus(m, (dir / "binned.inp").string());
+  writeAbaqus(m, (dir / "per-cell.inp").string(), perCell);
+  const std::string deck = slurp(dir / "binned.inp");
+  EXPECT_EQ(deck, slurp(dir / "per-cell.inp"));
+  std::size_t materials = 0;
+  for (auto at = deck.find("*MATERIAL"); at != std::string::npos;
+       at = deck.find("*MATERIAL", at + 1))
+  {
+    ++materials;
+  }
+  EXPECT_EQ(materials, 2u);
+  EXPECT_EQ(deck.find("*ELSET"), std::string::npos);
+  fs::remove_all(dir);
 }
 
 // A real solver: CalculiX on the two-material bar, pulled by F = 100 at x = 2. With nu = 0 the

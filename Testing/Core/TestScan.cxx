@@ -320,4 +320,62 @@ TEST(Inv3, CombinedVoxelCell)
     errorOf([&] { cellWith(R"([{"op": "blend", "inside": "1"}])"); }), HasSubstr("\"bound\""));
 }
 
+/// "stamp" on a voxel cell (voxel::stamp through the complex file): every grid point inside a
+/// stamp's region takes its value, in ascending priority (list order among equals), before the
+/// iso-surface sees the grid; ComplexFileReaders::scanRead gets the stamped grid (the study's
+/// materials read it).
+TEST(Inv3, StampedVoxelCell)
+{
+  TempDir dir;
+  const std::string path = dir.file("small.inv3");
+  // 3 x 2 x 2 points at x = 0, 0.5, 1 (spacing 0.5, 0.75, 1.5); value 100 i + 10 j + k - 50.
+  writeGzip(path, project(mainPlist("int16", 3, 2, 2), smallMatrix()));
+  std::shared_ptr<const voxel::VoxelGrid> seen;
+  auto cellWith = [&](const std::string& stamp)
+  {
+    lang::ComplexFileReaders readers;
+    readers.scanRead = [&](const std::string& cell, std::shared_ptr<const voxel::VoxelGrid> g)
+    {
+      EXPECT_EQ(cell, "bone");
+      seen = std::move(g);
+    };
+    const complex::Complex k = lang::readComplexJson(
+      R"({"cells": [{"name": "bone", "kind": "V", "dimension": 3, "file": ")" + path +
+        R"(", "iso": 0, "stamp": )" + stamp + "}]}",
+      "stamp.json", {}, readers);
+    return std::get<complex::ImplicitGeometry>(k.cell(k.cellsOfDimension(3)[0]).geometry);
+  };
+  // Titanium (1000) where x <= 0.6 (i = 0, 1) over air (-500) where x >= 0.25 (i = 1, 2): the
+  // higher priority wins at i = 1 although it is listed first.
+  const auto g = cellWith(R"([{"inside": "0.6 - x[1]", "value": 1000, "priority": 1},
+    {"inside": "x[1] - 0.25", "value": -500}])");
+  ASSERT_TRUE(seen);
+  for (int k = 0; k < 2; ++k)
+  {
+    for (int j = 0; j < 2; ++j)
+    {
+      EXPECT_EQ(seen->at(0, j, k), 1000);
+      EXPECT_EQ(seen->at(1, j, k), 1000);
+      EXPECT_EQ(seen->at(2, j, k), -500);
+    }
+  }
+  // The cell's field (iso 0) is the stamped grid's trilinear interpolant (at points where the
+  // box-distance term, L = 1500 / 0.5 times the distance to the grid's faces, is not lower).
+  EXPECT_NEAR(value(g.inside[0], { 0.5, 0.375, 0.75 }), 1000, 1e-9);
+  EXPECT_NEAR(value(g.inside[0], { 0.75, 0.375, 0.75 }), 250, 1e-9);
+  EXPECT_NEAR(value(g.inside[0], { 0.875, 0.1, 1.2 }), 0.25 * 1000 + 0.75 * -500, 1e-9);
+  // Equal priorities: list order, the later stamp wins.
+  cellWith(R"([{"inside": "0.6 - x[1]", "value": 7}, {"inside": "x[1] - 0.25", "value": 9}])");
+  EXPECT_EQ(seen->at(0, 1, 1), 7);
+  EXPECT_EQ(seen->at(1, 1, 1), 9);
+  EXPECT_EQ(seen->at(2, 0, 0), 9);
+  // Refusals name the stamp.
+  EXPECT_THAT(errorOf([&] { cellWith(R"([{"inside": "x[1] - 5", "value": 1}])"); }),
+    ::testing::AllOf(HasSubstr("stamp[0]"), HasSubstr("holds no point of the scan's grid")));
+  EXPECT_THAT(errorOf([&] { cellWith(R"([{"inside": "1"}])"); }),
+    ::testing::AllOf(HasSubstr("stamp[0]"), HasSubstr("\"value\"")));
+  EXPECT_THAT(errorOf([&] { cellWith(R"({"inside": "1", "value": 2})"); }),
+    HasSubstr("\"stamp\" must be a list"));
+}
+
 } // namespace

@@ -1068,24 +1068,44 @@ def check_study(ictk, work, data):
         sys.exit(f"FAIL: {CRANIUM} is missing: install invesalius-examples (Scripts/setup does)")
     model = os.path.join(data, "Studies", "ct-implant", "ct-implant.json")
     vtu = os.path.join(work, "ct.vtu")
-    # With CalculiX, the study also solves the compression case (--solve): E_app between the
-    # Reuss and Voigt bounds of its deck, the results beside the mesh.
-    solve = ["--solve", "0.06"] if shutil.which("ccx") else []
-    report = json.loads(run(ictk, ["study", model, "-o", vtu, "--deterministic", "--json"] + solve).stdout)
+    if not shutil.which("ccx"):
+        sys.exit("FAIL: ccx is missing: install calculix-ccx (Scripts/setup does)")
+    # The study also solves the compression case (--solve): E_app between the Reuss and Voigt
+    # bounds of its deck (the issue's number), the results beside the mesh.
+    report = json.loads(run(ictk, ["study", model, "-o", vtu, "--deterministic", "--json", "--solve", "0.06"]).stdout)
     if not os.path.exists(os.path.join(work, "ct.inp")):
         sys.exit("FAIL: no ct.inp beside ct.vtu")
-    if solve:
-        if not report["reuss_modulus"] <= report["apparent_modulus"] <= report["voigt_modulus"]:
-            sys.exit(f"FAIL: E_app {report['apparent_modulus']} outside [Reuss, Voigt] = "
-                     f"[{report['reuss_modulus']}, {report['voigt_modulus']}]")
-        if not os.path.exists(os.path.join(work, "ct-solved.vtu")):
-            sys.exit("FAIL: no ct-solved.vtu beside ct.vtu")
+    if not report["reuss_modulus"] <= report["apparent_modulus"] <= report["voigt_modulus"]:
+        sys.exit(f"FAIL: E_app {report['apparent_modulus']} outside [Reuss, Voigt] = "
+                 f"[{report['reuss_modulus']}, {report['voigt_modulus']}]")
+    print(f"study: E_app {report['apparent_modulus']:.1f} MPa, Reuss {report['reuss_modulus']:.1f}, "
+          f"Voigt {report['voigt_modulus']:.1f}")
+    if not os.path.exists(os.path.join(work, "ct-solved.vtu")):
+        sys.exit("FAIL: no ct-solved.vtu beside ct.vtu")
     no_leftovers(work)
     import vtk
     r = vtk.vtkXMLUnstructuredGridReader()
     r.SetFileName(vtu)
     r.Update()
     grid = r.GetOutput()
+    # The same specimen made homogeneous (every element E = 1000 MPa, nu = 0.3): between
+    # frictionless platens its apparent modulus is E itself, the Voigt bound (the issue: within
+    # 0.5 %). The mesh's own arrays are overwritten, so this is the study's mesh, solved apart.
+    homogeneous = vtk.vtkUnstructuredGrid()
+    homogeneous.DeepCopy(grid)
+    for name, v in (("youngs_modulus", 1000.0), ("poisson_ratio", 0.3), ("density", 1.0)):
+        a = homogeneous.GetCellData().GetArray(name)
+        for c in range(homogeneous.GetNumberOfCells()):
+            a.SetTuple1(c, v)
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(os.path.join(work, "homogeneous.vtu"))
+    w.SetInputData(homogeneous)
+    w.Write()
+    solved = json.loads(run(ictk, ["solve", os.path.join(work, "homogeneous.vtu"), "--compression", "0.06",
+                                   "-o", os.path.join(work, "homogeneous-solved.vtu"), "--json"]).stdout)
+    print(f"homogeneous specimen: E_app {solved['apparent_modulus']:.3f} MPa, Voigt {solved['voigt_modulus']:.3f}")
+    near(solved["voigt_modulus"], 1000, 1e-6, "homogeneous Voigt bound")
+    near(solved["apparent_modulus"] / solved["voigt_modulus"], 1, 0.005, "homogeneous E_app / Voigt")
     if grid.GetNumberOfCells() != report["tetrahedra"] or report["tetrahedra"] < 10000:
         sys.exit(f"FAIL: {grid.GetNumberOfCells()} tetrahedra in the .vtu, {report['tetrahedra']} reported")
     for name in ("label", "density", "youngs_modulus", "poisson_ratio"):
@@ -1100,6 +1120,7 @@ def check_study(ictk, work, data):
         sys.exit(f"FAIL: only {report['deck_materials']} deck materials from the scan's moduli")
 
     study = json.load(open(model))
+    check_study_stamp(ictk, work, study)
 
     def refused(name, pattern, scan=None, implant_z0=None, shell_radius=None):
         doc = json.loads(json.dumps(study))
@@ -1144,6 +1165,19 @@ def check_study(ictk, work, data):
             t.addfile(info, io.BytesIO(payload))
     refused("short", r"'matrix\.dat' holds 14024704 bytes; its shape 108 x 256 x 256 of int16 needs 14155776",
             scan=short)
+    # The same through VTK's readers: a MetaImage and a NRRD header of 10^3 int16 values whose
+    # raw file holds 9 slices (vtkmetaio only prints this on stderr and VTK hands on zeros).
+    open(os.path.join(work, "short.raw"), "wb").write(bytes(10 * 10 * 9 * 2))
+    with open(os.path.join(work, "short.mhd"), "w") as f:
+        f.write("ObjectType = Image\nNDims = 3\nDimSize = 10 10 10\nElementType = MET_SHORT\n"
+                "ElementSpacing = 1 1 1\nOffset = 0 0 0\nElementDataFile = short.raw\n")
+    refused("short-mhd", r"short\.mhd': its data holds fewer values than its header's size says "
+            r"\(ideal = 2000 : actual = 1800 bytes\)", scan=os.path.join(work, "short.mhd"))
+    with open(os.path.join(work, "short.nhdr"), "w") as f:
+        f.write("NRRD0004\ntype: short\ndimension: 3\nsizes: 10 10 10\nspacings: 1 1 1\n"
+                "encoding: raw\nendian: little\ndata file: short.raw\n")
+    refused("short-nrrd", r"short\.nhdr': its data holds fewer values than its header's size says",
+            scan=os.path.join(work, "short.nhdr"))
     refused("outside", r"implant 'implant' reaches outside the specimen on axis z: \[140, 152\.25\]",
             implant_z0=140)
     # A 0.1 mm shell at size 1: CGAL would lose it (or never finish); refused before meshing.
@@ -1170,6 +1204,52 @@ def check_study(ictk, work, data):
         sys.exit("FAIL: negative pitch: output written despite the error")
 
 
+def check_study_stamp(ictk, work, study):
+    """The study file's "stamp" (voxel::stamp on the scan cell): a bone graft of 1500 HU packed
+    about the pin (r < 5 mm) is written into the scan before it is meshed, so every tetrahedron
+    whose trilinear support lies inside the graft (r < 5 - 0.957 sqrt 2 = 3.646 mm) is bone with
+    E = 6850 (1 + 0.001 1500)^1.49 (the study's laws) and none there is soft tissue."""
+    import vtk
+    doc = json.loads(json.dumps(study))
+    for cell in doc["cells"]:
+        if cell["name"] == "bone":
+            cell["stamp"] = [{"inside": "5 - sqrt((x[1] - 122.5)^2 + (x[2] - 122.5)^2)", "value": 1500}]
+    folder = os.path.join(work, "stamp")
+    os.makedirs(folder)
+    path = os.path.join(folder, "study.json")
+    json.dump(doc, open(path, "w"), indent=2)
+    vtu = os.path.join(folder, "stamped.vtu")
+    run(ictk, ["study", path, "-o", vtu, "--deterministic", "--json"])
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(vtu)
+    r.Update()
+    grid = r.GetOutput()
+    labels = grid.GetCellData().GetArray("label")
+    modulus = grid.GetCellData().GetArray("youngs_modulus")
+    graft = 6850 * (1 + 0.001 * 1500) ** 1.49
+    checked = 0
+    for c in range(grid.GetNumberOfCells()):
+        ids = grid.GetCell(c).GetPointIds()
+        radii = []
+        for k in range(4):
+            x, y, _ = grid.GetPoint(ids.GetId(k))
+            radii.append(math.hypot(x - 122.5, y - 122.5))
+        # Outside the shell (r >= 3; its vertices lie on the shell's cylinder up to the
+        # tracer's error) and inside the support radius: r is convex, so the whole tetrahedron
+        # and all its sampling points are.
+        if not (min(radii) > 2.999 and max(radii) < 3.64):
+            continue
+        if labels.GetTuple1(c) != 2:
+            sys.exit(f"FAIL: stamp: tetrahedron {c} at r {min(radii):.3f}..{max(radii):.3f} has label "
+                     f"{labels.GetTuple1(c)}, not bone (2)")
+        if abs(modulus.GetTuple1(c) / graft - 1) > 1e-6:
+            sys.exit(f"FAIL: stamp: tetrahedron {c} has E {modulus.GetTuple1(c)}, the graft's {graft}")
+        checked += 1
+    print(f"stamp: {checked} tetrahedra in the graft ring, all bone with E = {graft:.2f} MPa")
+    if checked < 100:
+        sys.exit(f"FAIL: stamp: only {checked} tetrahedra in 3 < r < 3.64")
+
+
 def check_study_implants(ictk, work, data):
     """ictk study on ct-implants.json (issue 15): the screw, the plate and the scaffold mesh into
     their labels with the volumes of their formulas, and the study file's own "solve" runs
@@ -1194,6 +1274,10 @@ def check_study_implants(ictk, work, data):
         if abs(volumes[name] / expected - 1) > tolerance:
             sys.exit(f"FAIL: {name} volume {volumes[name]} against {expected} (tolerance {tolerance})")
     near(sum(volumes.values()), 24 * 24 * 6, 0.001 * 24 * 24 * 6, "total volume")
+    # At size 1 (the study's): measured worst dihedral 1.00 deg, first percentile 11.1-11.6 deg.
+    if report["size"] != 1 or report["min_dihedral_degrees"] < 0.5 or report["min_dihedral_percentile1_degrees"] < 10:
+        sys.exit(f"FAIL: size {report['size']}, dihedrals {report['min_dihedral_degrees']} (worst), "
+                 f"{report['min_dihedral_percentile1_degrees']} (1st percentile)")
     if not report["reuss_modulus"] <= report["apparent_modulus"] <= report["voigt_modulus"]:
         sys.exit(f"FAIL: E_app {report['apparent_modulus']} outside [Reuss, Voigt] = "
                  f"[{report['reuss_modulus']}, {report['voigt_modulus']}]")

@@ -597,6 +597,14 @@ private:
           "ictkComplexSource)");
       }
       voxel::validate(*grid, "'" + path + "'");
+      if (spec.contains("stamp") && !readStamps(spec["stamp"], *grid, where))
+      {
+        return;
+      }
+      if (readers_.scanRead)
+      {
+        readers_.scanRead(c.name, grid);
+      }
       const Box3 gridBox = grid->bounds();
       Box3 clipped = gridBox;
       if (!g.inside.empty())
@@ -630,6 +638,65 @@ private:
     {
       report(where + ": " + e.what(), current_);
     }
+  }
+
+  /// A voxel cell's "stamp": [{"inside": HyperFun, "value": v, "priority": p}, ...]: every grid
+  /// point inside a stamp's region takes its value (voxel::stamp: an implant written into the
+  /// scan with titanium's Hounsfield units, a drilled hole with air's), in ascending priority
+  /// (default 0; equal priorities in list order), so the stamp of highest priority wins where
+  /// regions overlap. Before the iso-surface and the combine see the grid.
+  bool readStamps(const Json& list, voxel::VoxelGrid& grid, const std::string& where)
+  {
+    if (!list.is_array())
+    {
+      report(where + ": \"stamp\" must be a list of {\"inside\", \"value\"}", current_);
+      return false;
+    }
+    struct Stamp
+    {
+      double priority;
+      FieldPtr region;
+      double value;
+      std::string at;
+    };
+    std::vector<Stamp> stamps;
+    const std::size_t before = problems_.size();
+    for (std::size_t i = 0; i < list.size(); ++i)
+    {
+      const Json& o = list[i];
+      const std::string at = where + ": stamp[" + std::to_string(i) + "]";
+      if (!o.is_object() || !o.contains("inside") || !o["inside"].is_string() ||
+        !o.contains("value") || !o["value"].is_number())
+      {
+        report(at + " must be {\"inside\": HyperFun, \"value\": number[, \"priority\": number]}",
+          current_);
+        return false;
+      }
+      const double value = o["value"].get<double>();
+      if (!std::isfinite(value))
+      {
+        report(at + ": \"value\" must be finite", current_);
+        return false;
+      }
+      stamps.push_back({ number(o, "priority", 0.0, at + ": \"priority\""),
+        field(compile(o["inside"].get<std::string>(), 3, at)), value, at });
+    }
+    if (problems_.size() != before)
+    {
+      return false; // a region that did not compile (reported) or a bad priority
+    }
+    std::stable_sort(stamps.begin(), stamps.end(),
+      [](const Stamp& a, const Stamp& b) { return a.priority < b.priority; });
+    for (const Stamp& s : stamps)
+    {
+      // A region that misses every grid point is a mistake (a wrong frame or sign), not a no-op.
+      if (voxel::stamp(grid, *s.region, s.value) == 0)
+      {
+        report(s.at + ": the region holds no point of the scan's grid", current_);
+        return false;
+      }
+    }
+    return true;
   }
 
   /// A voxel cell's "combine": [{"op": "union" | "intersection" | "difference" | "blend",

@@ -30,6 +30,10 @@ struct ComplexFileReaders
   std::function<std::shared_ptr<voxel::VoxelGrid>(
     const std::string& path, const std::string& array)>
     volume;
+  /// Told each voxel cell's name and grid as the cell's field reads it (after its "stamp"), so
+  /// that a study takes its materials' Hounsfield units from the very values it meshed.
+  std::function<void(const std::string& cell, std::shared_ptr<const voxel::VoxelGrid> grid)>
+    scanRead;
 };
 
 /// True for paths ending in .json (case-insensitive).

@@ -46,6 +46,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <sstream>
 #include <type_traits>
 
 vtkStandardNewMacro(ictkComplexSource);
@@ -174,6 +176,12 @@ std::string readFailure(
     return type.empty() ? "not a VTK XML " + expected + " file"
                         : "a VTK " + type + " file, not " + expected;
   }
+  // vtkImageReader2 (NRRD's raw data): the data file ended before the header's sizes did.
+  if (e.rfind("File operation failed", 0) == 0)
+  {
+    return "its data holds fewer values than its header's size says; the data file is "
+           "truncated or the header is wrong";
+  }
   const std::string stl = "STLReader error reading file: " + path + " ";
   if (e.rfind(stl, 0) == 0)
   {
@@ -230,7 +238,42 @@ vtkSmartPointer<Reader> readWith(const std::string& path, const std::string& for
     reader->SetReaderErrorObserver(capture.Observer());
   }
   reader->SetFileName(path.c_str());
-  reader->Update();
+  {
+    // MetaImage's library (vtkmetaio) reports a data file shorter than its header's DimSize only
+    // on std::cerr ("M_ReadElementsData: data not read completely") and VTK then hands on the
+    // image with the missing values zero: a silent wrong scan. Its stream is taken for the read.
+    std::ostringstream metaio;
+    std::streambuf* cerr = std::cerr.rdbuf(metaio.rdbuf());
+    try
+    {
+      reader->Update();
+    }
+    catch (...)
+    {
+      std::cerr.rdbuf(cerr);
+      throw;
+    }
+    std::cerr.rdbuf(cerr);
+    const std::string said = metaio.str();
+    if (said.find("not read completely") != std::string::npos)
+    {
+      const std::size_t ideal = said.find("ideal");
+      std::string detail = ideal == std::string::npos ? std::string() : said.substr(ideal);
+      detail.erase(std::remove(detail.begin(), detail.end(), '\n'), detail.end());
+      throw std::invalid_argument("cannot read '" + path +
+        "': its data holds fewer values than its header's size says" +
+        (detail.empty() ? std::string() : " (" + detail + " bytes)") +
+        "; the data file is truncated or the header is wrong");
+    }
+    if (!said.empty() && capture.Errors.empty() && reader->GetErrorCode() == 0)
+    {
+      std::cerr << said; // nothing this reader refuses: let it be seen as before
+    }
+    else if (!said.empty())
+    {
+      capture.Errors.push_back(said);
+    }
+  }
   if (!capture.Errors.empty() || reader->GetErrorCode() != 0 || !reader->GetOutputDataObject(0))
   {
     throw std::invalid_argument("cannot read '" + path + "'" +
@@ -414,11 +457,13 @@ void ictkComplexSource::SetComplex(std::shared_ptr<const ictk::complex::Complex>
   this->Modified();
 }
 
-complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path)
+complex::Complex ictkComplexSource::ReadComplexFile(const std::string& path,
+  std::function<void(const std::string&, std::shared_ptr<const voxel::VoxelGrid>)> scanRead)
 {
   lang::ComplexFileReaders readers;
   readers.mesh = readMesh;
   readers.volume = readVolume;
+  readers.scanRead = std::move(scanRead);
   return lang::readComplexFile(path, {}, readers);
 }
 

@@ -46,9 +46,10 @@
 #include "ictkFiltersComplexModule.h" // export macro
 #include "vtkPartitionedDataSetCollectionAlgorithm.h"
 
-#include <memory> // for std::shared_ptr
-#include <string> // for std::string
-#include <vector> // for std::vector
+#include <functional> // for std::function
+#include <memory>     // for std::shared_ptr
+#include <string>     // for std::string
+#include <vector>     // for std::vector
 
 class vtkDataAssembly;
 class vtkDataObject;
@@ -62,6 +63,10 @@ namespace complex
 {
 class Complex;
 } // namespace complex
+namespace voxel
+{
+struct VoxelGrid;
+} // namespace voxel
 } // namespace ictk
 #endif
 
@@ -118,8 +123,11 @@ public:
 #ifndef __VTK_WRAP__
   /// Reads a .json complex with VTK's readers for the cells' files: explicit cells from .vtp,
   /// .vtu, .stl, .ply, .obj; voxel cells from .vti, .mha/.mhd, .nii/.nii.gz, .nrrd/.nhdr (and
-  /// .vdb through the core). Throws ictk::lang::ParseError.
-  static ictk::complex::Complex ReadComplexFile(const std::string& path);
+  /// .vdb through the core). Throws ictk::lang::ParseError. `scanRead`, when set, is told each
+  /// voxel cell's grid as the cell reads it (ictk::lang::ComplexFileReaders::scanRead).
+  static ictk::complex::Complex ReadComplexFile(const std::string& path,
+    std::function<void(const std::string&, std::shared_ptr<const ictk::voxel::VoxelGrid>)>
+      scanRead = {});
   /// The complex a dataset made by this source carries (COMPLEX()), or nullptr.
   static std::shared_ptr<const ictk::complex::Complex> GetComplex(vtkDataObject* data);
   /// Sets COMPLEX() on a dataset's information, as this source does on its output (for other
