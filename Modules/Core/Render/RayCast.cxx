@@ -3,6 +3,7 @@
 
 #include "Render/RayCaster.h"
 
+#include "Discretize/Surface.h"
 #include "FRep/Evaluators.h"
 #include "FRep/RootFinding.h"
 #include "FRep/Threads.h"
@@ -819,6 +820,49 @@ RayCastResult rayCast(
   const TapePtr& field, const Box3& box, const Camera& camera, const RayCastOptions& options)
 {
   return castModel(field, nullptr, box, camera, options);
+}
+
+ScenePrimitives modelScene(const frep::Hypervolume& model, const Box3& box, double featureSize,
+  const RayCastOptions& options)
+{
+  const frep::TapePtr tape = frep::Tape::compile(model.geometry().function());
+  if (tape->parameterCount() > options.parameters.size())
+  {
+    throw std::invalid_argument("the model has " + std::to_string(tape->parameterCount()) +
+      " parameter(s) but " + std::to_string(options.parameters.size()) + " value(s) were given");
+  }
+  const auto [offset, scalar] = attributeOf(model, options.colours.attribute);
+  ColourMap::named(options.colours.map); // an unknown map fails before the work
+  if (!(featureSize > 0))
+  {
+    // The default of `ictk mesh` for a complex: 1/64 of the largest side.
+    featureSize =
+      std::max({ box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2] }) / 64;
+  }
+  discretize::SurfaceOptions so;
+  so.featureSize = featureSize;
+  so.threads = options.threads;
+  so.progress = options.progress;
+  discretize::SurfaceMesh mesh =
+    discretize::contourSurface(*frep::tapeField(tape, options.time, options.parameters), box, so);
+  Primitives p;
+  p.points = std::move(mesh.points);
+  p.triangles = std::move(mesh.triangles);
+  p.normals = vertexNormals(p.points, p.triangles);
+  if (offset >= 0)
+  {
+    AttributePainter painter(
+      model, options.parameters, options.time, static_cast<std::size_t>(offset), scalar);
+    p.paints.reserve(p.points.size());
+    for (const Point3& x : p.points)
+    {
+      p.paints.push_back(painter.at(x));
+    }
+  }
+  ScenePrimitives scene;
+  scene.scalar = offset >= 0 && scalar;
+  scene.meshed.push_back(std::move(p));
+  return scene;
 }
 
 RayCastResult rayCast(const frep::Hypervolume& model, const Box3& box, const Camera& camera,
