@@ -376,12 +376,15 @@ def write_two_cubes(path):
     material = vtk.vtkIntArray()
     material.SetName("MaterialId")
     for cube in range(2):
-        for path in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
+        for order in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
             c = [cube, 0, 0]
             ids = [c[0] * 4 + c[1] * 2 + c[2]]
-            for axis in path:
+            for axis in order:
                 c[axis] += 1
                 ids.append(c[0] * 4 + c[1] * 2 + c[2])
+            # Positively oriented, as .vtu readers of tetrahedra expect: an odd order flips it.
+            if order in ((0, 2, 1), (1, 0, 2), (2, 1, 0)):
+                ids[2], ids[3] = ids[3], ids[2]
             grid.InsertNextCell(vtk.VTK_TETRA, 4, ids)
             material.InsertNextValue(cube + 1)
     grid.GetCellData().AddArray(material)
