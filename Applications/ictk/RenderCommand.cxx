@@ -11,6 +11,7 @@
 #include "Options.h"
 #include "Pictures.h"
 #include "ProgressDisplay.h"
+#include "VtkMessages.h"
 
 #include "Complex/Discretization.h"
 #include "Engine/FrameSequence.h"
@@ -675,11 +676,16 @@ private:
     const auto t0 = Clock::now();
     vtkNew<vtkXMLUnstructuredGridReader> reader;
     reader->SetFileName(this->Model.c_str());
+    // VTK's reader reports a file it cannot parse as VTK errors: the first becomes our line.
+    ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+    const std::size_t errorsBefore = messages->Errors.size();
     reader->Update();
     vtkUnstructuredGrid* grid = reader->GetOutput();
-    if (reader->GetErrorCode() != 0 || !grid)
+    if (reader->GetErrorCode() != 0 || !grid || messages->Errors.size() > errorsBefore)
     {
-      throw UserError("cannot read '" + this->Model + "' as a VTK unstructured grid (.vtu)");
+      const std::string cause = messages->FirstCause(errorsBefore);
+      throw UserError("cannot read '" + this->Model + "' as a VTK unstructured grid (.vtu)" +
+        (cause.empty() ? std::string() : ": " + cause));
     }
     mesh::TetMesh m;
     try

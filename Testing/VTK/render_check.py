@@ -456,6 +456,30 @@ def check_tetcut(ictk, work, data):
                            text=True)
         if q.returncode != 2 or message not in q.stderr or os.path.exists(out):
             sys.exit(f"FAIL: {args}: exit {q.returncode}, stderr:\n{q.stderr}")
+    # Files that are not meshes of tetrahedra.
+    import vtk
+    garbage = os.path.join(work, "garbage.vtu")
+    with open(garbage, "w") as f:
+        f.write("not XML\n")
+    triangles = os.path.join(work, "triangle.vtu")
+    grid = vtk.vtkUnstructuredGrid()
+    points = vtk.vtkPoints()
+    for p in ((0, 0, 0), (1, 0, 0), (0, 1, 0)):
+        points.InsertNextPoint(*p)
+    grid.SetPoints(points)
+    grid.InsertNextCell(vtk.VTK_TRIANGLE, 3, [0, 1, 2])
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(triangles)
+    w.SetInputData(grid)
+    w.Write()
+    for path, message in ((garbage, "as a VTK unstructured grid (.vtu): Error parsing XML"),
+                          (triangles, "cell 0 is a vtkTriangle, not a tetrahedron"),
+                          (os.path.join(work, "nope.vtu"), "cannot read '")):
+        out = os.path.join(work, "bad.png")
+        q = subprocess.run([ictk, "render", path, "-o", out], capture_output=True, text=True)
+        lines = q.stderr.strip().splitlines()
+        if q.returncode != 2 or len(lines) != 1 or message not in lines[0] or os.path.exists(out):
+            sys.exit(f"FAIL: {path}: exit {q.returncode}, stderr:\n{q.stderr}")
     q = subprocess.run([ictk, "render", "walnut", "-o", os.path.join(work, "bad.png"), "--cut",
                         "1,0,0,0"], capture_output=True, text=True)
     if q.returncode != 2 or "--cut cuts a tetrahedral mesh (.vtu) open" not in q.stderr:
