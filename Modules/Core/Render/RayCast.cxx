@@ -851,12 +851,30 @@ ScenePrimitives modelScene(const frep::Hypervolume& model, const Box3& box, doub
   p.normals = vertexNormals(p.points, p.triangles);
   if (offset >= 0)
   {
+    // As the ray caster, the attribute is taken inside the solid: a vertex of the contour lies
+    // on f = 0 to the root finder's accuracy, on either side, and where the attribute changes at
+    // the surface (a material outside the solid) the outside value would show. A vertex outside
+    // is moved along the gradient (towards larger f) in steps growing from 1e-4 of a cell until
+    // f >= 0 (at most about a cell).
     AttributePainter painter(
       model, options.parameters, options.time, static_cast<std::size_t>(offset), scalar);
+    frep::GradientEvaluator gradient(tape, options.parameters);
     p.paints.reserve(p.points.size());
     for (const Point3& x : p.points)
     {
-      p.paints.push_back(painter.at(x));
+      Point3 q = x;
+      frep::ValueGradient g = gradient.eval(x[0], x[1], x[2], options.time);
+      const double n = std::hypot(g.gradient[0], g.gradient[1], g.gradient[2]);
+      double step = 1e-4 * featureSize;
+      for (int k = 0; k < 14 && g.value < 0 && n > 0 && std::isfinite(n); ++k, step *= 2)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          q[a] = x[a] + step * g.gradient[a] / n;
+        }
+        g.value = gradient.eval(q[0], q[1], q[2], options.time).value;
+      }
+      p.paints.push_back(painter.at(g.value >= 0 ? q : x));
     }
   }
   ScenePrimitives scene;
