@@ -13,9 +13,11 @@
 //   sphere-gyroid-0.025   dual contouring of libfive's sphereGyroid over [-5,5]^3 at feature
 //                         size 0.025, 2 threads
 //   render-sphere-gyroid-1024  ray casting (Render/RayCast.h) of the same sphereGyroid, 1024^2
-//                         pixels from the default view, 2 threads; pixels/s and interval
-//                         evaluations per pixel
-//   render-walnut-1024    the same for the bundled walnut
+//                         pixels, orthographic from +z over [-5,5]^2 (libfive's heightmap view:
+//                         with --peer-libfive, against its heightmap over 1024^3 voxels, the
+//                         depth images compared), 2 threads; pixels/s and interval evaluations
+//                         per pixel
+//   render-walnut-1024    the same for the bundled walnut, perspective from the default view
 //   flower-256            the discretisation of every cell of Data/Models/flower/flower.json at
 //                         1/256 of its size (surfaces, patches, traced curves, points)
 //   ct-implant            issue 15's study (Data/Studies/ct-implant/ct-implant.json): read and crop
@@ -1162,7 +1164,8 @@ CLI::App* BenchCommand::add(CLI::App& app)
     "--quick", Options.Quick, "Small sizes (prospero 128^2, csg3 64^3), one run: a smoke test");
   bench->add_option("--peer-libfive", Options.PeerLibfive,
     "Instead of the workloads: time libfive's l5bench (path; ../shared/bench/peers/libfive/build "
-    "prints it) side by side with ICTK on prospero and sphereGyroid, and VTK on csg3, in "
+    "prints it) side by side with ICTK on prospero and sphereGyroid (and, with the harness copy "
+    "that has `heightmap`, the ray caster against libfive's heightmap), and VTK on csg3, in "
     "alternating rounds, and print the ratios of this run");
   bench->add_option("--rounds", Options.Rounds, "Alternating rounds of --peer-libfive (medians)")
     ->check(CLI::Range(1, 100));
