@@ -13,9 +13,11 @@
 //   sphere-gyroid-0.025   dual contouring of libfive's sphereGyroid over [-5,5]^3 at feature
 //                         size 0.025, 2 threads
 //   render-sphere-gyroid-1024  ray casting (Render/RayCast.h) of the same sphereGyroid, 1024^2
-//                         pixels from the default view, 2 threads; pixels/s and interval
-//                         evaluations per pixel
-//   render-walnut-1024    the same for the bundled walnut
+//                         pixels, orthographic from +z over [-5,5]^2 (libfive's heightmap view:
+//                         with --peer-libfive, against its heightmap over 1024^3 voxels, the
+//                         depth images compared), 2 threads; pixels/s and interval evaluations
+//                         per pixel
+//   render-walnut-1024    the same for the bundled walnut, perspective from the default view
 //   flower-256            the discretisation of every cell of Data/Models/flower/flower.json at
 //                         1/256 of its size (surfaces, patches, traced curves, points)
 //   ct-implant            issue 15's study (Data/Studies/ct-implant/ct-implant.json): read and crop
@@ -77,6 +79,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <optional>
@@ -463,24 +466,22 @@ Result SphereGyroid(double featureSize)
   return r;
 }
 
-/// Ray casting of one field over `box` into size^2 pixels, perspective from the default view.
+/// Ray casting of one field over `box` into the camera's pixels.
 Result RenderField(const std::string& workload, const std::string& what, const frep::TapePtr& tape,
-  const frep::Box3& box, int size)
+  const frep::Box3& box, const render::Camera& camera)
 {
   Result r;
   r.workload = workload;
-  r.what = what + ", " + std::to_string(size) + "^2 pixels, perspective from the default view";
+  r.what = what;
   r.threads = ThreadsOr(2);
   r.unit = "Mpixels/s";
-  const render::Camera camera =
-    render::Camera::orbit(box, {}, render::Projection::Perspective, size, size);
   render::RayCastOptions options;
   options.threads = r.threads;
   render::RayCastResult image;
   r.allSeconds = Time(
     Options.Runs, [&] { image = render::rayCast(tape, box, camera, options); }, &r.cpuSeconds);
   r.seconds = Median(r.allSeconds);
-  r.work = static_cast<double>(size) * size;
+  r.work = static_cast<double>(camera.width()) * camera.height();
   r.details["covered_pixels"] = image.coveredPixels;
   r.details["unresolved_pixels"] = image.unresolvedPixels;
   r.details["interval_evaluations_per_pixel"] = image.intervalEvaluations / r.work;
@@ -488,20 +489,122 @@ Result RenderField(const std::string& workload, const std::string& what, const f
   return r;
 }
 
+/// The view of libfive's heightmap (issue 14's anchor): an orthographic camera looking down -z
+/// at the square [-5,5]^2, up +y, so that pixel (i, j) is centred at x = -5 + (i + 1/2) 10/size,
+/// y likewise: the centres of the columns of libfive's size^3 voxels over [-5,5]^3. A surface
+/// at depth s is at z = kGyroidEyeHeight - s.
+constexpr double kGyroidEyeHeight = 15;
+
+render::Camera GyroidTopCamera(int size)
+{
+  return render::Camera::lookAt({ 0, 0, kGyroidEyeHeight }, { 0, 0, 0 }, { 0, 1, 0 },
+    render::Projection::Orthographic, render::PerspectiveFieldOfView, 5, size, size);
+}
+
+const std::string kRenderGyroidWhat =
+  "ray casting of libfive's sphereGyroid over [-5,5]^3, orthographic from +z (libfive's "
+  "heightmap view)";
+
 Result RenderSphereGyroid(int size)
 {
   return RenderField("render-sphere-gyroid-" + std::to_string(size),
-    "ray casting of libfive's sphereGyroid over [-5,5]^3",
-    frep::Tape::compile(bundled::sphereGyroidField()), { { -5, -5, -5 }, { 5, 5, 5 } }, size);
+    kRenderGyroidWhat + ", " + std::to_string(size) + "^2 pixels",
+    frep::Tape::compile(bundled::sphereGyroidField()), kGyroidBox, GyroidTopCamera(size));
+}
+
+/// libfive's heightmap (`l5bench heightmap`, the copy of the harness named in
+/// docs/performance.md): size^2 float32, row y, column x, the z of the highest voxel centre
+/// inside the solid, -inf where none.
+std::vector<float> ReadHeightmap(const std::string& path, int size)
+{
+  std::vector<float> z(static_cast<std::size_t>(size) * size);
+  std::ifstream in(path, std::ios::binary);
+  in.read(
+    reinterpret_cast<char*>(z.data()), static_cast<std::streamsize>(z.size() * sizeof(float)));
+  if (!in || in.peek() != std::char_traits<char>::eof())
+  {
+    throw std::runtime_error("--peer-libfive: '" + path + "' is not a " + std::to_string(size) +
+      " x " + std::to_string(size) + " float32 heightmap");
+  }
+  return z;
+}
+
+/// Do the ray caster's depth image and libfive's heightmap show the same solid? The pixel
+/// centres are the voxel columns' centres (GyroidTopCamera); libfive's value is the highest voxel
+/// centre inside, so where both cover a pixel the ray caster's first crossing z is expected
+/// within one voxel h = 10/size of it (above it, by less than h, when the solid is thicker than
+/// a voxel there). A pixel disagrees when one covers it and the other does not, or when the two
+/// heights differ by more than h. A disagreement is explained when the ray caster's surface is a
+/// feature thinner than a voxel that libfive's samples pass between: the voxel centre just below
+/// the ray caster's crossing is outside the solid, so no voxel centre of that column sees it.
+nlohmann::json CompareWithHeightmap(const render::RayCastResult& image,
+  const std::vector<float>& heightmap, const frep::TapePtr& tape, int size)
+{
+  frep::PointEvaluator field(tape);
+  const double h = 10.0 / size;
+  const auto centre = [&](int i)
+  {
+    return -5 + (i + 0.5) * h;
+  };
+  std::int64_t both = 0, ictkOnly = 0, libfiveOnly = 0, beyondVoxel = 0, explained = 0;
+  double largest = 0;
+  for (int j = 0; j < size; ++j)
+  {
+    for (int i = 0; i < size; ++i)
+    {
+      const std::size_t p = static_cast<std::size_t>(j) * size + i;
+      const bool ours = std::isfinite(image.depth[p]);
+      const bool theirs = std::isfinite(heightmap[p]);
+      const double z = kGyroidEyeHeight - image.depth[p];
+      bool thinnerThanVoxel = false;
+      if (ours)
+      {
+        const int below = static_cast<int>(std::floor((z + 5) / h - 0.5));
+        thinnerThanVoxel = below >= 0 && field.eval(centre(i), centre(j), centre(below)) < 0;
+      }
+      if (ours && theirs)
+      {
+        ++both;
+        const double d = z - heightmap[p];
+        largest = std::max(largest, std::abs(d) / h);
+        if (std::abs(d) > h)
+        {
+          ++beyondVoxel;
+          explained += d > 0 && thinnerThanVoxel;
+        }
+      }
+      else if (ours)
+      {
+        ++ictkOnly;
+        explained += thinnerThanVoxel;
+      }
+      else if (theirs)
+      {
+        ++libfiveOnly;
+      }
+    }
+  }
+  nlohmann::json j;
+  j["both_covered_pixels"] = both;
+  j["silhouette_disagreeing_pixels"] = ictkOnly + libfiveOnly;
+  j["covered_by_ictk_only"] = ictkOnly;
+  j["covered_by_libfive_only"] = libfiveOnly;
+  j["depth_beyond_a_voxel_pixels"] = beyondVoxel;
+  j["largest_depth_difference_voxels"] = largest;
+  j["disagreeing_thinner_than_a_voxel"] = explained;
+  j["disagreeing_unexplained"] = ictkOnly + libfiveOnly + beyondVoxel - explained;
+  return j;
 }
 
 Result RenderWalnut(int size)
 {
   const frep::ModelInfo& walnut = frep::findModel("walnut");
+  const frep::Box3 box{ walnut.boundsLo, walnut.boundsHi };
   return RenderField("render-walnut-" + std::to_string(size),
-    "ray casting of the bundled walnut (shell and kernel) over its bounds",
-    frep::Tape::compile(walnut.build().geometry().function()), { walnut.boundsLo, walnut.boundsHi },
-    size);
+    "ray casting of the bundled walnut (shell and kernel) over its bounds, " +
+      std::to_string(size) + "^2 pixels, perspective from the default view",
+    frep::Tape::compile(walnut.build().geometry().function()), box,
+    render::Camera::orbit(box, {}, render::Projection::Perspective, size, size));
 }
 
 Result Flower(int divisions)
@@ -854,6 +957,8 @@ nlohmann::json SurfaceDistance(
 constexpr double kHeightmapGoalRatio = 6.0;
 constexpr double kSignOnlyGoalRatio = 3.0;
 constexpr double kGyroidGoalRatio = 12.0;
+/// Issue 14's goal: the ray caster at least 3x libfive's heightmap at the same resolution.
+constexpr double kRenderGoalRatio = 3.0;
 
 std::vector<PeerCase> PeerCases(const std::string& l5bench, bool quick)
 {
@@ -1020,6 +1125,71 @@ std::vector<PeerCase> PeerCases(const std::string& l5bench, bool quick)
     cases.push_back(std::move(c));
   }
 
+  const std::string renderGyroid = "render-sphere-gyroid-" + n;
+  if (Selected(renderGyroid))
+  {
+    if (!PeerHasCommand(l5bench, { "heightmap", "1", "1", "8" }))
+    {
+      std::cerr << "ictk bench: skipping " << renderGyroid << ": '" << l5bench
+                << "' has no `heightmap` command (the shipped harness renders N x N x 1 voxels "
+                   "only; docs/performance.md says how to build the copy that adds N x N x N)\n";
+    }
+    else
+    {
+      PeerCase c;
+      c.workload = renderGyroid;
+      c.threads = ThreadsOr(2);
+      c.what = kRenderGyroidWhat + ", " + n + "^2 pixels, against libfive's heightmap over " + n +
+        "^3 voxels of the same box";
+      const frep::TapePtr tape = frep::Tape::compile(bundled::sphereGyroidField());
+      const render::Camera camera = GyroidTopCamera(size);
+      auto image = std::make_shared<render::RayCastResult>();
+      render::RayCastOptions options;
+      options.threads = c.threads;
+      const double pixels = static_cast<double>(size) * size;
+      PeerSide ictk = InProcessSide(
+        "ICTK", "ray caster (Render/RayCast.h)", runs,
+        [=] { *image = render::rayCast(tape, kGyroidBox, camera, options); },
+        [=]
+        {
+          return nlohmann::json{ { "covered_pixels", image->coveredPixels },
+            { "unresolved_pixels", image->unresolvedPixels },
+            { "interval_evaluations_per_pixel", image->intervalEvaluations / pixels },
+            { "point_evaluations_per_pixel", image->pointEvaluations / pixels } };
+        });
+      const std::string depthFile = (std::filesystem::temp_directory_path() /
+        ("ictk-bench-heightmap-" + std::to_string(getpid()) + ".f32"))
+                                      .string();
+      PeerSide libfive = LibfiveSide("Heightmap::render (with normals), " + n + "^3 voxels",
+        l5bench, { "heightmap", std::to_string(c.threads), std::to_string(runs), n, depthFile });
+      // Pixels per second on both sides; the silhouettes compared after each libfive round,
+      // against the ray caster's last image (the ICTK side runs first in round 0).
+      const auto perSecond = [pixels](PeerRound& r)
+      {
+        r.details["mpixels_per_second"] = pixels / r.seconds / 1e6;
+      };
+      ictk.round = [inner = ictk.round, perSecond]
+      {
+        PeerRound r = inner();
+        perSecond(r);
+        return r;
+      };
+      libfive.round = [inner = libfive.round, perSecond, image, depthFile, tape, size]
+      {
+        PeerRound r = inner();
+        perSecond(r);
+        const std::vector<float> heightmap = ReadHeightmap(depthFile, size);
+        std::filesystem::remove(depthFile);
+        r.details.update(CompareWithHeightmap(*image, heightmap, tape, size));
+        return r;
+      };
+      c.sides.push_back(std::move(ictk));
+      c.sides.push_back(std::move(libfive));
+      c.ratios.push_back({ 0, 1, kRenderGoalRatio });
+      cases.push_back(std::move(c));
+    }
+  }
+
   const int sampleSize = quick ? 64 : 512;
   if (Selected("csg3-" + std::to_string(sampleSize)))
   {
@@ -1072,7 +1242,8 @@ CLI::App* BenchCommand::add(CLI::App& app)
     "--quick", Options.Quick, "Small sizes (prospero 128^2, csg3 64^3), one run: a smoke test");
   bench->add_option("--peer-libfive", Options.PeerLibfive,
     "Instead of the workloads: time libfive's l5bench (path; ../shared/bench/peers/libfive/build "
-    "prints it) side by side with ICTK on prospero and sphereGyroid, and VTK on csg3, in "
+    "prints it) side by side with ICTK on prospero and sphereGyroid (and, with the harness copy "
+    "that has `heightmap`, the ray caster against libfive's heightmap), and VTK on csg3, in "
     "alternating rounds, and print the ratios of this run");
   bench->add_option("--rounds", Options.Rounds, "Alternating rounds of --peer-libfive (medians)")
     ->check(CLI::Range(1, 100));

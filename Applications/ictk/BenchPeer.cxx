@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -215,6 +216,18 @@ PeerSide LibfiveSide(std::string label, std::string l5bench, std::vector<std::st
     return r;
   };
   return side;
+}
+
+bool PeerHasCommand(const std::string& l5bench, const std::vector<std::string>& args)
+{
+  std::string command = ShellQuote(l5bench);
+  for (const std::string& a : args)
+  {
+    command += " " + ShellQuote(a);
+  }
+  command += " >/dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
 void CheckPeerExecutable(const std::string& path)

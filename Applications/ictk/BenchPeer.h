@@ -60,6 +60,9 @@ PeerSide InProcessSide(std::string tool, std::string label, int runs, std::funct
 /// round's times (l5bench makes its own warm-up run) and whose other JSON lines the details.
 PeerSide LibfiveSide(std::string label, std::string l5bench, std::vector<std::string> args);
 
+/// Whether `l5bench args...` runs and exits with 0 (its output discarded): which commands a
+/// harness has (the copy for N x N x N heightmaps adds `heightmap`).
+bool PeerHasCommand(const std::string& l5bench, const std::vector<std::string>& args);
 /// Throws std::invalid_argument unless `path` is an executable file.
 void CheckPeerExecutable(const std::string& path);
 

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `ictk render`: pictures drawn by the core (Render/): an FRep model (a registered name, .hf,
 // .xml, .vm) ray cast; a complex (.json) or a dynamic model (.icm at --time) with its cells of
-// every dimension composed through one depth buffer (Render/ComplexRender.h); and with --frames,
+// every dimension composed through one depth buffer (Render/ComplexRender.h); a tetrahedral mesh
+// (.vtu) by the faces of its elements, cut open by --cut (Render/TetCut.h); and with --frames,
 // a range of frames of an XYZT model or a .icm model as numbered PNGs or an .mp4 film. This
 // file resolves the input, the camera and the colours; Pictures.h writes the results.
 #include "Command.h"
@@ -10,11 +11,21 @@
 #include "Options.h"
 #include "Pictures.h"
 #include "ProgressDisplay.h"
+#include "VtkMessages.h"
 
 #include "Complex/Discretization.h"
 #include "Engine/FrameSequence.h"
 #include "Render/ComplexRender.h"
 #include "Render/RayCast.h"
+#include "Render/TetCut.h"
+#include "ictkSolverResults.h"
+
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -22,6 +33,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iomanip>
@@ -90,6 +102,19 @@ Drawn FromComplex(render::ComplexRenderResult&& r)
   return d;
 }
 
+/// A picture drawn by VTK's polygon pipeline (--mode mesh) or the rasteriser alone.
+Drawn FromCanvas(render::Canvas&& c)
+{
+  Drawn d;
+  d.Width = c.width;
+  d.Height = c.height;
+  d.Covered = c.covered();
+  d.Colour = std::move(c.colour);
+  d.Depth = std::move(c.depth);
+  d.Mesh = true; // no interval evaluations to report
+  return d;
+}
+
 class RenderCommand final : public Command
 {
 public:
@@ -99,8 +124,8 @@ public:
       "Draw an FRep model, a complex or a dynamic model into a PNG picture (or, with --frames, "
       "numbered PNGs or an .mp4 film), see docs/render.md");
     AddModel(render, this->Model,
-      "Model name (see `ictk models`), a .hf / .xml / .vm / .blob file, a .json complex or a .icm "
-      "dynamic model");
+      "Model name (see `ictk models`), a .hf / .xml / .vm / .blob file, a .json complex, a .icm "
+      "dynamic model or a .vtu tetrahedral mesh");
     AddOutput(render, this->Output,
       "Output picture (.png); with --frames a pattern (frames/%04d.png) or an .mp4 film");
     render->add_option(
@@ -128,7 +153,12 @@ public:
     AddParams(render, this->Params);
     render->add_option("--colour-by", this->ColourBy,
       "The attribute that colours the picture: a colour (3 components) or a scalar drawn "
-      "through --colour-map (default: the attribute `colour`, if any)");
+      "through --colour-map (default: the attribute `colour`, if any); for a .vtu mesh a cell "
+      "or point array of 1 component (MaterialId, youngs_modulus, von_mises, ...)");
+    render->add_option("--cut", this->Cut,
+      "nx,ny,nz,d: a .vtu tetrahedral mesh cut open by the plane n . x = d: the tetrahedra "
+      "whose centroid has n . x > d are left out, the others kept whole and seen by their "
+      "faces");
     render->add_option("--colour-map", this->ColourMapName,
       "Colour map of a scalar attribute: cool-warm (default), rainbow, grey");
     render->add_option("--range", this->Range,
@@ -144,8 +174,8 @@ public:
       "1/64 of the complex's largest side)");
     render->add_option("--mode", this->Mode,
       "raycast (default: solids ray cast exactly, meshed cells rasterised exactly) or mesh "
-      "(every cell's discretisation through VTK's OpenGL pipeline offscreen; complexes only, "
-      "needs an X display or xvfb-run)");
+      "(a model's dual-contoured surface, every cell's discretisation, through VTK's OpenGL "
+      "pipeline offscreen; needs an X display or xvfb-run)");
     render->add_option("--pick", this->PickAt,
       "X,Y: also print what the picture shows at pixel column X (from the left) and row Y (from "
       "the top): the surface point, its depth and, for a scene (.scn), the id of the frontmost "
@@ -161,6 +191,32 @@ public:
     this->CheckOptions();
     const bool complexFile = IsComplexInput(this->Model);
     const bool dynamic = HasExtension(this->Model, ".icm");
+    const bool tetMesh = HasExtension(this->Model, ".vtu");
+    if (tetMesh)
+    {
+      if (!this->Bounds.empty() || this->TimeOption->count() > 0 || !this->Frames.empty() ||
+        this->Mode != "raycast" || !this->PickAt.empty())
+      {
+        throw UserError("render: '" + this->Model +
+          "' is a tetrahedral mesh: --bounds, --time, --frames, --mode mesh and --pick are for "
+          "models and complexes (a mesh is cut open by --cut)");
+      }
+      InterruptScope interrupts;
+      try
+      {
+        return this->RunTetMesh();
+      }
+      catch (const Cancelled&)
+      {
+        std::cerr << "ictk: interrupted; nothing written\n";
+        return ExitInterrupted;
+      }
+    }
+    if (!this->Cut.empty())
+    {
+      throw UserError("--cut cuts a tetrahedral mesh (.vtu) open; an FRep model is cut by its "
+                      "box (--bounds)");
+    }
     if ((complexFile || dynamic) && !this->Bounds.empty())
     {
       throw UserError("--bounds: the box to draw in is for FRep models; a complex's cells have "
@@ -243,7 +299,7 @@ private:
     {
       throw UserError("--mode must be raycast or mesh, got '" + this->Mode + "'");
     }
-    if (this->Mode == "mesh" && (IsComplexInput(this->Model) || HasExtension(this->Model, ".icm")))
+    if (this->Mode == "mesh" && !HasExtension(this->Model, ".vtu"))
     {
       CheckMeshDisplay();
     }
@@ -430,10 +486,6 @@ private:
   /// The FRep model to ray cast, in its box or --bounds'.
   ResolvedModel ModelToDraw() const
   {
-    if (this->Mode == "mesh")
-    {
-      throw UserError("--mode mesh draws complexes (.json, .icm): an FRep model is only ray cast");
-    }
     ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
     if (!this->Bounds.empty())
     {
@@ -452,6 +504,16 @@ private:
     options.colours = this->Colours;
     options.progress = progress;
     const frep::Box3 box{ model.Lo, model.Hi };
+    if (this->Mode == "mesh")
+    {
+      return Guarded(
+        [&]
+        {
+          return FromCanvas(
+            DrawMeshes(render::modelScene(model.Model, box, this->FeatureSize, options), camera,
+              this->Colours));
+        });
+    }
     return Guarded([&] { return FromRayCast(render::rayCast(model.Model, box, camera, options)); });
   }
 
@@ -469,16 +531,8 @@ private:
       return Guarded(
         [&]
         {
-          render::Canvas c = DrawMeshes(
-            render::scenePrimitives(complex, mesh, options, true), camera, this->Colours);
-          Drawn d;
-          d.Width = c.width;
-          d.Height = c.height;
-          d.Covered = c.covered();
-          d.Colour = std::move(c.colour);
-          d.Depth = std::move(c.depth);
-          d.Mesh = true;
-          return d;
+          return FromCanvas(DrawMeshes(
+            render::scenePrimitives(complex, mesh, options, true), camera, this->Colours));
         });
     }
     return Guarded(
@@ -591,6 +645,155 @@ private:
               << " (" << drawn.Width << " x " << drawn.Height << ", " << Describe(drawn) << ") in "
               << std::fixed << std::setprecision(3) << seconds << " s\n";
     Warn(drawn, name);
+    return 0;
+  }
+
+  /// A .vtu tetrahedral mesh, cut open by --cut, coloured by --colour-by's cell or point array.
+  int RunTetMesh()
+  {
+    std::optional<render::CutPlane> cut;
+    if (!this->Cut.empty())
+    {
+      const std::vector<double> c =
+        ParseNumbers(this->Cut, "--cut", { "nx", "ny", "nz", "d" }, 4, 4, "nx,ny,nz,d");
+      if (c[0] == 0 && c[1] == 0 && c[2] == 0)
+      {
+        throw UserError("--cut: the plane's normal nx,ny,nz is zero");
+      }
+      cut = render::CutPlane{ { c[0], c[1], c[2] }, c[3] };
+    }
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(this->Model, ec))
+    {
+      throw UserError("cannot read '" + this->Model + "'");
+    }
+    AtomicOutput picture(this->Output);
+    std::optional<AtomicOutput> depthFile;
+    if (!this->Depth.empty())
+    {
+      depthFile.emplace(this->Depth);
+    }
+    const auto t0 = Clock::now();
+    vtkNew<vtkXMLUnstructuredGridReader> reader;
+    reader->SetFileName(this->Model.c_str());
+    // VTK's reader reports a file it cannot parse as VTK errors: the first becomes our line.
+    ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+    const std::size_t errorsBefore = messages->Errors.size();
+    reader->Update();
+    vtkUnstructuredGrid* grid = reader->GetOutput();
+    if (reader->GetErrorCode() != 0 || !grid || messages->Errors.size() > errorsBefore)
+    {
+      const std::string cause = messages->FirstCause(errorsBefore);
+      throw UserError("cannot read '" + this->Model + "' as a VTK unstructured grid (.vtu)" +
+        (cause.empty() ? std::string() : ": " + cause));
+    }
+    mesh::TetMesh m;
+    try
+    {
+      m = ictk::vtk::tetMeshFromVTK(grid, this->Model);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      throw UserError(std::string("render: ") + e.what());
+    }
+    render::TetPaint paint;
+    if (!this->ColourBy.empty())
+    {
+      vtkDataArray* a = grid->GetCellData()->GetArray(this->ColourBy.c_str());
+      const bool perTetrahedron = a != nullptr;
+      if (!a)
+      {
+        a = grid->GetPointData()->GetArray(this->ColourBy.c_str());
+      }
+      if (!a)
+      {
+        std::string known;
+        for (vtkDataSetAttributes* d : { static_cast<vtkDataSetAttributes*>(grid->GetCellData()),
+               static_cast<vtkDataSetAttributes*>(grid->GetPointData()) })
+        {
+          for (int i = 0; i < d->GetNumberOfArrays(); ++i)
+          {
+            if (d->GetArray(i) && d->GetArrayName(i))
+            {
+              known += (known.empty() ? "" : ", ") + std::string(d->GetArrayName(i));
+            }
+          }
+        }
+        throw UserError("--colour-by: '" + this->Model + "' has no cell or point array '" +
+          this->ColourBy + "' (it has: " + (known.empty() ? std::string("none") : known) + ")");
+      }
+      if (a->GetNumberOfComponents() != 1)
+      {
+        throw UserError("--colour-by: the array '" + this->ColourBy + "' of '" + this->Model +
+          "' has " + std::to_string(a->GetNumberOfComponents()) +
+          " components; a mesh is coloured by a scalar (1 component)");
+      }
+      std::vector<double>& values = perTetrahedron ? paint.perTetrahedron : paint.perPoint;
+      values.resize(static_cast<std::size_t>(a->GetNumberOfTuples()));
+      for (vtkIdType i = 0; i < a->GetNumberOfTuples(); ++i)
+      {
+        values[static_cast<std::size_t>(i)] = a->GetTuple1(i);
+      }
+    }
+    // The camera looks at the whole mesh's box, so a cut does not move it.
+    frep::Box3 box{ m.points[0], m.points[0] };
+    for (const frep::Point3& p : m.points)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        box.lo[a] = std::min(box.lo[a], p[a]);
+        box.hi[a] = std::max(box.hi[a], p[a]);
+      }
+    }
+    const render::Camera camera = this->MakeCamera(box);
+    ProgressBar bar("rendering " + this->Model, true);
+    Drawn drawn = this->Guarded(
+      [&]
+      {
+        const render::TetFaces faces = render::tetrahedronFaces(m.points, m.tetrahedra, cut);
+        const bool scalar = !paint.perPoint.empty() || !paint.perTetrahedron.empty();
+        render::Canvas canvas(this->Width, this->Height,
+          scalar ? render::Canvas::Colouring::Scalar : render::Canvas::Colouring::Rgb);
+        render::RasterOptions options;
+        options.threads = this->Threads;
+        options.progress = [&bar](double f)
+        {
+          bar.Show(f);
+          return !Interrupted();
+        };
+        render::rasterize(
+          canvas, camera, render::tetrahedronFacePrimitives(m.points, faces, paint), options);
+        std::array<double, 2> range{ std::numeric_limits<double>::quiet_NaN(),
+          std::numeric_limits<double>::quiet_NaN() };
+        if (scalar)
+        {
+          range = render::finishColours(canvas, this->Colours);
+        }
+        Drawn d = FromCanvas(std::move(canvas));
+        d.ScalarRange = range;
+        this->KeptTetrahedra = faces.keptTetrahedra;
+        return d;
+      });
+    bar.End();
+    const double seconds = Seconds(t0);
+    WritePng(drawn.Buffers(), picture, this->Output);
+    if (depthFile)
+    {
+      WriteDepth(drawn.Buffers(), *depthFile);
+    }
+    std::cout << "wrote " << this->Output << (depthFile ? " and " + this->Depth : std::string())
+              << " (" << drawn.Width << " x " << drawn.Height << ", " << this->KeptTetrahedra
+              << " of " << m.tetrahedra.size() << " tetrahedra kept, " << Describe(drawn) << ") in "
+              << std::fixed << std::setprecision(3) << seconds << " s\n";
+    if (this->KeptTetrahedra == 0)
+    {
+      std::cerr << "ictk: warning: --cut leaves no tetrahedron of '" << this->Model
+                << "'; the picture is empty (background only)\n";
+    }
+    else
+    {
+      Warn(drawn, this->Model);
+    }
     return 0;
   }
 
@@ -808,6 +1011,8 @@ private:
   double FeatureSize = 0;
   std::string Mode = "raycast";
   std::string Bounds;
+  std::string Cut;
+  std::int64_t KeptTetrahedra = 0;
   std::string CameraFile;
   CLI::Option* ViewOption = nullptr;
   CLI::Option* ProjectionOption = nullptr;

@@ -283,6 +283,15 @@ def check_render(ictk, work):
     alpha = r.GetOutput().GetPointData().GetScalars()
     if any(alpha.GetComponent(k, 3) != 0 for k in range(64)):
         sys.exit("FAIL: the empty picture is not background")
+    # A model with a surface, but a camera that looks away from it: the same honest empty picture.
+    away = os.path.join(work, "away.json")
+    with open(away, "w") as f:
+        f.write('{"position": [0, 5, 0], "focal_point": [0, 10, 0]}')
+    out = os.path.join(work, "away.png")
+    p = run(ictk, ["render", "sphere", "-o", out, "--size", "8,8", "--camera", away])
+    if "ictk: warning: no surface of 'sphere' is in view" not in p.stderr or \
+            "0 pixels covered" not in p.stdout or not os.path.exists(out):
+        sys.exit(f"FAIL: no warning or no picture for a camera looking away:\n{p.stderr}")
     no_leftovers(work)
 
 
@@ -518,7 +527,7 @@ def check_bench(ictk, work):
 # seconds, so three rounds have the median 2 * BASE.
 FAKE_L5BENCH = """#!/usr/bin/python3
 import json, os, sys
-BASE = {"brute": 0.5, "pruned": 0.125, "signonly": 0.0625, "gyroid": 2.0}
+BASE = {"brute": 0.5, "pruned": 0.125, "signonly": 0.0625, "gyroid": 2.0, "heightmap": 0.25}
 cmd = sys.argv[1]
 if os.environ.get("FAKE_L5BENCH_FAIL") == cmd:
     sys.exit(3)
@@ -532,6 +541,13 @@ print("libfive banner, not JSON")
 print(json.dumps({"workload": cmd, "seconds": s, "cpu_seconds": s / 2, "all_seconds": [s]}))
 if cmd == "gyroid":
     print(json.dumps({"workload": "mesh", "triangles": 20000, "vertices": 10000}))
+elif cmd == "heightmap":  # N^2 float32 depths: empty everywhere, or z = 4.9 everywhere
+    import struct
+    n = int(sys.argv[4])
+    if len(sys.argv) > 5:
+        z = 4.9 if os.environ.get("FAKE_HEIGHTMAP_TOP") else float("-inf")
+        open(sys.argv[5], "wb").write(struct.pack("<f", z) * (n * n))
+    print(json.dumps({"covered_pixels": 0, "voxels": [n, n, n]}))
 else:
     print(json.dumps({"inside_pixels": 1234}))
 """
@@ -555,10 +571,12 @@ def check_bench_peer(ictk, work):
     if d["rounds"] != 3 or d["peer_libfive"] != fake:
         sys.exit(f"FAIL: peer header: {d}")
     cases = {c["workload"]: c for c in d["cases"]}
-    if sorted(cases) != ["csg3-64", "prospero-brute-128", "prospero-pruned-128", "sphere-gyroid-0.1"]:
+    if sorted(cases) != ["csg3-64", "prospero-brute-128", "prospero-pruned-128",
+                         "render-sphere-gyroid-128", "sphere-gyroid-0.1"]:
         sys.exit(f"FAIL: peer workloads: {sorted(cases)}")
     base = {"ArrayEvaluator": 0.5, "Heightmap (with normals)": 0.125,
-            "Heightmap's recursion, no normals": 0.0625, "Mesh::render, min_feature 0.025": 2.0}
+            "Heightmap's recursion, no normals": 0.0625, "Mesh::render, min_feature 0.025": 2.0,
+            "Heightmap::render (with normals), 128^3 voxels": 0.25}
     for c in d["cases"]:
         sides = {s["tool"] + " " + s["label"]: s for s in c["sides"]}
         for s in c["sides"]:
@@ -598,6 +616,34 @@ def check_bench_peer(ictk, work):
     goals = [r for r in cases["sphere-gyroid-0.1"]["ratios"] if "goal_ratio" in r]
     if [(r["ictk"], r["goal_ratio"]) for r in goals] != [("dual contouring, libfive's triangle count", 12)]:
         sys.exit(f"FAIL: sphereGyroid goal: {goals}")
+    # The ray caster against an empty heightmap: every pixel it covers disagrees, none is
+    # libfive's alone; the goal is 3x.
+    r = cases["render-sphere-gyroid-128"]
+    ours, theirs = (next(s for s in r["sides"] if s["tool"] == t) for t in ("ICTK", "libfive"))
+    covered = ours["details"]["covered_pixels"]
+    # The sphere of radius 3 covers 9 pi / 100 of the square, less the gyroid's channels.
+    if not 0.2 * 128 * 128 < covered < 9 * math.pi / 100 * 128 * 128 or \
+            not ours["details"]["interval_evaluations_per_pixel"] > 0:
+        sys.exit(f"FAIL: render-sphere-gyroid-128 ICTK details: {ours['details']}")
+    t = theirs["details"]
+    if (t["both_covered_pixels"], t["covered_by_ictk_only"], t["covered_by_libfive_only"],
+            t["silhouette_disagreeing_pixels"]) != (0, covered, 0, covered) or \
+            not 0 <= t["disagreeing_thinner_than_a_voxel"] <= covered or \
+            t["disagreeing_unexplained"] != covered - t["disagreeing_thinner_than_a_voxel"]:
+        sys.exit(f"FAIL: render-sphere-gyroid-128 comparison with an empty heightmap: {t}")
+    near(t["mpixels_per_second"], 128 * 128 / 0.25 / 1e6, 1e-9, "libfive Mpixels/s")
+    if [x["goal_ratio"] for x in r["ratios"]] != [3]:
+        sys.exit(f"FAIL: render-sphere-gyroid-128 goal: {r['ratios']}")
+    # A heightmap at z = 4.9 everywhere: every pixel covered by both where the ray caster covers
+    # it, more than a voxel (10/128) above its surface (the sphere has radius 3).
+    env = dict(os.environ, FAKE_HEIGHTMAP_TOP="1")
+    p = subprocess.run([ictk, "bench", "--quick", "--json", "--rounds", "1", "--only",
+                        "render-sphere-gyroid", "--peer-libfive", fake], capture_output=True,
+                       text=True, timeout=100, env=env)
+    t = json.loads(p.stdout)["cases"][0]["sides"][1]["details"]
+    if (t["both_covered_pixels"], t["covered_by_libfive_only"], t["depth_beyond_a_voxel_pixels"],
+            t["disagreeing_thinner_than_a_voxel"]) != (covered, 128 * 128 - covered, covered, 0):
+        sys.exit(f"FAIL: render-sphere-gyroid-128 against a heightmap at z = 4.9: {t}")
     csg3 = cases["csg3-64"]
     if [s["tool"] for s in csg3["sides"]] != ["ICTK", "VTK"] or csg3["ratios"][0]["goal_ratio"] != 15:
         sys.exit(f"FAIL: csg3 sides: {csg3}")
@@ -607,6 +653,10 @@ def check_bench_peer(ictk, work):
     for want in (f"brute {model} 1 128", f"pruned {model} 2 1 128", f"signonly {model} 2 1 128", "gyroid 2 1"):
         if calls.count(want) != 3:
             sys.exit(f"FAIL: l5bench calls: {want!r} {calls.count(want)} times in {calls}")
+    # The heightmap: probed once per run (8^3), then 1 run per round into a depth file.
+    heightmaps = [c for c in calls if c.startswith("heightmap 2 1 128 ")]
+    if calls.count("heightmap 1 1 8") != 2 or len(heightmaps) != 4:
+        sys.exit(f"FAIL: l5bench heightmap calls: {calls}")
     # The Markdown tables of the plain report.
     out = run(ictk, ["bench", "--quick", "--rounds", "1", "--only", "pruned", "--models", models,
                      "--peer-libfive", fake]).stdout

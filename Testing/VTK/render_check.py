@@ -4,7 +4,8 @@
 what it prints and writes (the FRep model pictures are ictk_cli_check.py's `render`).
 
 Usage: render_check.py --ictk PATH --work DIR --data DATA CHECK
-  flower | icm | frames | film | interrupt | inside | camera | baselines | pictures | mesh
+  flower | icm | frames | film | interrupt | inside | camera | baselines | pictures | mesh |
+  tetcut
 baselines compares pictures with Testing/Data/Baseline/Render*.png; with the environment variable
 ICTK_REGENERATE_BASELINES=1 it writes them instead.
 mesh needs an X display (run it under Testing/ParaView/run_checked.py --xvfb).
@@ -267,14 +268,25 @@ def check_baselines(ictk, work, data):
 
 def check_pictures(ictk, work, data):
     """The README shows, under its pictures, the commands Scripts/pictures makes them with, and
-    every picture is there; each command runs (at a tenth of the size, into the work folder)."""
+    every picture is there; each command runs (at a tenth of the size, into the work folder),
+    after the `ictk tetra` commands that make the meshes some pictures draw."""
     root = os.path.join(data, "..")
     with open(os.path.join(root, "Scripts", "pictures")) as f:
-        lines = [l.split() for l in f if l.startswith("picture ")]
+        script = [l.split() for l in f]
+    lines = [l for l in script if l and l[0] == "picture"]
+    meshes = [l for l in script if l and l[0] == "tetra"]
     with open(os.path.join(root, "README.md")) as f:
         readme = f.read()
-    if len(lines) < 6:
+    if len(lines) < 7:
         sys.exit(f"FAIL: {len(lines)} pictures in Scripts/pictures")
+    made = {}
+    for out, *args in (l[1:] for l in meshes):
+        command = f"ictk tetra {' '.join(args)} -o {out}"
+        if command not in readme:
+            sys.exit(f"FAIL: the README does not show {command!r}")
+        made[out] = os.path.join(work, out)
+        run(ictk, ["tetra"] + [os.path.join(root, a) if a.startswith("Data/") else a
+                               for a in args] + ["-o", made[out]])
     for name, *args in (l[1:] for l in lines):
         command = f"ictk render {' '.join(args)} -o docs/images/{name}"
         if command not in readme:
@@ -283,8 +295,10 @@ def check_pictures(ictk, work, data):
                 os.path.join(root, "docs", "images", name)):
             sys.exit(f"FAIL: docs/images/{name} is not in the README or not in docs/images")
         small = [a if a != "240,180" else "24,18" for a in args]
-        run(ictk, ["render"] + [os.path.join(root, a) if a.startswith("Data/") else a
-                                for a in small] + ["-o", os.path.join(work, name)])
+        run(ictk, ["render"] + [os.path.join(root, a) if a.startswith("Data/") else
+                                made.get(a, a) for a in small] + ["-o", os.path.join(work, name)])
+    for path in made.values():
+        os.remove(path)
     no_leftovers(work)
 
 
@@ -297,24 +311,23 @@ def read_depth(path):
     return [a.GetValue(i) for i in range(a.GetNumberOfTuples())]
 
 
-def check_mesh(ictk, work, data):
-    """The flower ray cast and through VTK's polygon pipeline (--mode mesh): the coverage masks
+def compare_modes(ictk, work, name, model, w, h, view, threshold_off=0.005):
+    """One picture ray cast and through VTK's polygon pipeline (--mode mesh): the coverage masks
     agree on at least 99 % of the pixels, and where both are covered the depths agree within a
     pixel's footprint, except next to a silhouette (a jump of the ray-cast depth to a neighbour),
     where the two may see different surfaces."""
-    w, h = 160, 120
-    flower = os.path.join(data, "Models/flower/flower.json")
     depth = {}
     for mode in ("raycast", "mesh"):
-        png, vti = os.path.join(work, mode + ".png"), os.path.join(work, mode + ".vti")
-        run(ictk, ["render", flower, "-o", png, "--depth", vti, "--size", f"{w},{h}",
-                   "--view", "-70,25", "--mode", mode])
+        png, vti = (os.path.join(work, f"{name}-{mode}.png"),
+                    os.path.join(work, f"{name}-{mode}.vti"))
+        run(ictk, ["render", model, "-o", png, "--depth", vti, "--size", f"{w},{h}",
+                   "--view", view, "--mode", mode])
         depth[mode] = read_depth(vti)
     ray, mesh = depth["raycast"], depth["mesh"]
     agree = sum(1 for a, b in zip(ray, mesh) if math.isfinite(a) == math.isfinite(b))
-    print(f"coverage agrees on {agree} of {w * h} pixels")
+    print(f"{name}: coverage agrees on {agree} of {w * h} pixels")
     if agree < 0.99 * w * h:
-        sys.exit(f"FAIL: coverage agrees on {agree} of {w * h} pixels only")
+        sys.exit(f"FAIL: {name}: coverage agrees on {agree} of {w * h} pixels only")
     pixel = 2 * math.tan(math.radians(15)) / h  # a pixel's side at distance 1 (30 degrees high)
     both = off = 0
     for k, (a, b) in enumerate(zip(ray, mesh)):
@@ -328,12 +341,149 @@ def check_mesh(ictk, work, data):
         near = [ray[jj * w + ii] for ii, jj in ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1))
                 if 0 <= ii < w and 0 <= jj < h]
         if not any(not math.isfinite(n) or abs(n - a) > 3 * footprint for n in near):
-            sys.exit(f"FAIL: pixel {i},{j}: depths {a} (ray cast) and {b} (mesh) differ by more "
-                     f"than a footprint ({footprint}) away from any silhouette")
+            sys.exit(f"FAIL: {name}: pixel {i},{j}: depths {a} (ray cast) and {b} (mesh) differ "
+                     f"by more than a footprint ({footprint}) away from any silhouette")
         off += 1
-    print(f"depths agree within a footprint on {both - off} of {both} pixels covered by both")
-    if off > 0.005 * both:
-        sys.exit(f"FAIL: {off} of {both} depths differ by more than a footprint")
+    print(f"{name}: depths agree within a footprint on {both - off} of {both} pixels covered by "
+          "both")
+    if off > threshold_off * both:
+        sys.exit(f"FAIL: {name}: {off} of {both} depths differ by more than a footprint")
+
+
+def check_mesh(ictk, work, data):
+    """The flower complex and a lone FRep model (the walnut) ray cast and through VTK's polygon
+    pipeline (--mode mesh): see compare_modes."""
+    compare_modes(ictk, work, "flower", os.path.join(data, "Models/flower/flower.json"), 160, 120,
+                  "-70,25")
+    compare_modes(ictk, work, "walnut", "walnut", 160, 120, "30,20")
+    print("all checks passed")
+
+
+def write_two_cubes(path):
+    """The box [0,2] x [0,1] x [0,1] as two unit cubes of six Kuhn tetrahedra each (materials 1
+    and 2 in the cell array MaterialId; the point array x is each point's x)."""
+    import vtk
+    points = vtk.vtkPoints()
+    x = vtk.vtkDoubleArray()
+    x.SetName("x")
+    for i in range(3):
+        for j in range(2):
+            for k in range(2):
+                points.InsertNextPoint(i, j, k)
+                x.InsertNextValue(i)
+    grid = vtk.vtkUnstructuredGrid()
+    grid.SetPoints(points)
+    material = vtk.vtkIntArray()
+    material.SetName("MaterialId")
+    for cube in range(2):
+        for order in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
+            c = [cube, 0, 0]
+            ids = [c[0] * 4 + c[1] * 2 + c[2]]
+            for axis in order:
+                c[axis] += 1
+                ids.append(c[0] * 4 + c[1] * 2 + c[2])
+            # Positively oriented, as .vtu readers of tetrahedra expect: an odd order flips it.
+            if order in ((0, 2, 1), (1, 0, 2), (2, 1, 0)):
+                ids[2], ids[3] = ids[3], ids[2]
+            grid.InsertNextCell(vtk.VTK_TETRA, 4, ids)
+            material.InsertNextValue(cube + 1)
+    grid.GetCellData().AddArray(material)
+    grid.GetPointData().AddArray(x)
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(path)
+    w.SetInputData(grid)
+    if not w.Write():
+        sys.exit(f"cannot write {path}")
+
+
+def check_tetcut(ictk, work, data):
+    """A .vtu tetrahedral mesh cut open (--cut) against the cut worked out by hand: the two
+    cubes cut by x = 1 keep the first cube's 6 tetrahedra; seen orthographically from +x (40 x 40
+    pixels of 0.05), the cut face covers exactly the 20 x 20 pixels whose centres lie in the unit
+    square, in the grey map's colour of material 1 (its low end: 0.15), or, by the point array x
+    over [0, 2], its middle (0.575); the other side of the cut keeps material 2. Bad input is
+    refused."""
+    import json
+    mesh = os.path.join(work, "cubes.vtu")
+    write_two_cubes(mesh)
+    camera = os.path.join(work, "camera.json")
+    with open(camera, "w") as f:
+        json.dump({"position": [5, 0.5, 0.5], "focal_point": [0, 0.5, 0.5], "up": [0, 0, 1],
+                   "projection": "orthographic", "parallel_scale": 1}, f)
+    cases = [("material", ["--cut", "1,0,0,1", "--colour-by", "MaterialId", "--range", "1,2"],
+              round(255 * 0.15), 6),
+             ("x", ["--cut", "1,0,0,1", "--colour-by", "x", "--range", "0,2"],
+              round(255 * 0.575), 6),
+             ("other-side", ["--cut", "-1,0,0,-1", "--colour-by", "MaterialId", "--range", "1,2"],
+              255, 6)]
+    for name, args, grey, kept in cases:
+        png = os.path.join(work, name + ".png")
+        view = camera
+        if name == "other-side":  # seen from -x: the cut face of the second cube
+            view = os.path.join(work, "camera-x.json")
+            with open(view, "w") as f:
+                json.dump({"position": [-5, 0.5, 0.5], "focal_point": [0, 0.5, 0.5],
+                           "up": [0, 0, 1], "projection": "orthographic",
+                           "parallel_scale": 1}, f)
+        p = run(ictk, ["render", mesh, "-o", png, "--size", "40,40", "--camera", view,
+                       "--colour-map", "grey"] + args)
+        if f"{kept} of 12 tetrahedra kept, 400 pixels covered" not in p.stdout:
+            sys.exit(f"FAIL: {name}: expected 6 of 12 tetrahedra and 400 pixels:\n{p.stdout}")
+        w, h, pixels = read_png(png)
+        for row in range(h):
+            for col in range(w):
+                r, g, b, a = pixels[row * w + col]
+                inside = 10 <= row < 30 and 10 <= col < 30
+                if inside != (a == 255):
+                    sys.exit(f"FAIL: {name}: pixel {col},{row} alpha {a}")
+                if inside and abs(r - grey) > 1:
+                    sys.exit(f"FAIL: {name}: pixel {col},{row} is {r}, expected {grey}")
+    # The whole mesh, no colours: its 12 tetrahedra, and a cut that leaves nothing warns.
+    p = run(ictk, ["render", mesh, "-o", os.path.join(work, "whole.png"), "--size", "40,40"])
+    if "12 of 12 tetrahedra kept" not in p.stdout:
+        sys.exit(f"FAIL: the whole mesh:\n{p.stdout}")
+    p = run(ictk, ["render", mesh, "-o", os.path.join(work, "none.png"), "--size", "8,8",
+                   "--cut", "1,0,0,-5"])
+    if "--cut leaves no tetrahedron" not in p.stderr:
+        sys.exit(f"FAIL: no warning for a cut that leaves nothing:\n{p.stderr}")
+    for args, message in (
+            (["--cut", "0,0,0,1"], "--cut: the plane's normal nx,ny,nz is zero"),
+            (["--cut", "1,0,0"], "--cut: expected nx,ny,nz,d"),
+            (["--colour-by", "nope"], "has no cell or point array 'nope' (it has: MaterialId, x)"),
+            (["--time", "1"], "is a tetrahedral mesh: --bounds, --time")):
+        out = os.path.join(work, "bad.png")
+        q = subprocess.run([ictk, "render", mesh, "-o", out] + args, capture_output=True,
+                           text=True)
+        if q.returncode != 2 or message not in q.stderr or os.path.exists(out):
+            sys.exit(f"FAIL: {args}: exit {q.returncode}, stderr:\n{q.stderr}")
+    # Files that are not meshes of tetrahedra.
+    import vtk
+    garbage = os.path.join(work, "garbage.vtu")
+    with open(garbage, "w") as f:
+        f.write("not XML\n")
+    triangles = os.path.join(work, "triangle.vtu")
+    grid = vtk.vtkUnstructuredGrid()
+    points = vtk.vtkPoints()
+    for p in ((0, 0, 0), (1, 0, 0), (0, 1, 0)):
+        points.InsertNextPoint(*p)
+    grid.SetPoints(points)
+    grid.InsertNextCell(vtk.VTK_TRIANGLE, 3, [0, 1, 2])
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(triangles)
+    w.SetInputData(grid)
+    w.Write()
+    for path, message in ((garbage, "as a VTK unstructured grid (.vtu): Error parsing XML"),
+                          (triangles, "cell 0 is a vtkTriangle, not a tetrahedron"),
+                          (os.path.join(work, "nope.vtu"), "cannot read '")):
+        out = os.path.join(work, "bad.png")
+        q = subprocess.run([ictk, "render", path, "-o", out], capture_output=True, text=True)
+        lines = q.stderr.strip().splitlines()
+        if q.returncode != 2 or len(lines) != 1 or message not in lines[0] or os.path.exists(out):
+            sys.exit(f"FAIL: {path}: exit {q.returncode}, stderr:\n{q.stderr}")
+    q = subprocess.run([ictk, "render", "walnut", "-o", os.path.join(work, "bad.png"), "--cut",
+                        "1,0,0,0"], capture_output=True, text=True)
+    if q.returncode != 2 or "--cut cuts a tetrahedral mesh (.vtu) open" not in q.stderr:
+        sys.exit(f"FAIL: --cut on a model: exit {q.returncode}, stderr:\n{q.stderr}")
     print("all checks passed")
 
 
@@ -347,7 +497,7 @@ def main():
     checks = {"flower": check_flower, "icm": check_icm, "frames": check_frames,
               "film": check_film, "interrupt": check_interrupt, "inside": check_inside,
               "camera": check_camera, "baselines": check_baselines,
-              "pictures": check_pictures, "mesh": check_mesh}
+              "pictures": check_pictures, "mesh": check_mesh, "tetcut": check_tetcut}
     if check not in checks:
         sys.exit(f"unknown check {check!r}")
     checks[check](ictk, work, data)

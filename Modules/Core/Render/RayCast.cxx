@@ -3,6 +3,7 @@
 
 #include "Render/RayCaster.h"
 
+#include "Discretize/Surface.h"
 #include "FRep/Evaluators.h"
 #include "FRep/RootFinding.h"
 #include "FRep/Threads.h"
@@ -819,6 +820,67 @@ RayCastResult rayCast(
   const TapePtr& field, const Box3& box, const Camera& camera, const RayCastOptions& options)
 {
   return castModel(field, nullptr, box, camera, options);
+}
+
+ScenePrimitives modelScene(const frep::Hypervolume& model, const Box3& box, double featureSize,
+  const RayCastOptions& options)
+{
+  const frep::TapePtr tape = frep::Tape::compile(model.geometry().function());
+  if (tape->parameterCount() > options.parameters.size())
+  {
+    throw std::invalid_argument("the model has " + std::to_string(tape->parameterCount()) +
+      " parameter(s) but " + std::to_string(options.parameters.size()) + " value(s) were given");
+  }
+  const auto [offset, scalar] = attributeOf(model, options.colours.attribute);
+  ColourMap::named(options.colours.map); // an unknown map fails before the work
+  if (!(featureSize > 0))
+  {
+    // The default of `ictk mesh` for a complex: 1/64 of the largest side.
+    featureSize =
+      std::max({ box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2] }) / 64;
+  }
+  discretize::SurfaceOptions so;
+  so.featureSize = featureSize;
+  so.threads = options.threads;
+  so.progress = options.progress;
+  discretize::SurfaceMesh mesh =
+    discretize::contourSurface(*frep::tapeField(tape, options.time, options.parameters), box, so);
+  Primitives p;
+  p.points = std::move(mesh.points);
+  p.triangles = std::move(mesh.triangles);
+  p.normals = vertexNormals(p.points, p.triangles);
+  if (offset >= 0)
+  {
+    // As the ray caster, the attribute is taken inside the solid: a vertex of the contour lies
+    // on f = 0 to the root finder's accuracy, on either side, and where the attribute changes at
+    // the surface (a material outside the solid) the outside value would show. A vertex outside
+    // is moved along the gradient (towards larger f) in steps growing from 1e-4 of a cell until
+    // f >= 0 (at most about a cell).
+    AttributePainter painter(
+      model, options.parameters, options.time, static_cast<std::size_t>(offset), scalar);
+    frep::GradientEvaluator gradient(tape, options.parameters);
+    p.paints.reserve(p.points.size());
+    for (const Point3& x : p.points)
+    {
+      Point3 q = x;
+      frep::ValueGradient g = gradient.eval(x[0], x[1], x[2], options.time);
+      const double n = std::hypot(g.gradient[0], g.gradient[1], g.gradient[2]);
+      double step = 1e-4 * featureSize;
+      for (int k = 0; k < 14 && g.value < 0 && n > 0 && std::isfinite(n); ++k, step *= 2)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          q[a] = x[a] + step * g.gradient[a] / n;
+        }
+        g.value = gradient.eval(q[0], q[1], q[2], options.time).value;
+      }
+      p.paints.push_back(painter.at(g.value >= 0 ? q : x));
+    }
+  }
+  ScenePrimitives scene;
+  scene.scalar = offset >= 0 && scalar;
+  scene.meshed.push_back(std::move(p));
+  return scene;
 }
 
 RayCastResult rayCast(const frep::Hypervolume& model, const Box3& box, const Camera& camera,

@@ -64,6 +64,7 @@
 #include "FRep/Tape.h"
 #include "Render/Camera.h"
 #include "Render/Canvas.h"
+#include "Render/ComplexRender.h"
 
 #include <array>
 #include <cstdint>
@@ -132,6 +133,15 @@ RayCastResult rayCast(const frep::TapePtr& field, const frep::Box3& box, const C
 /// colour map or a reversed range.
 RayCastResult rayCast(const frep::Hypervolume& model, const frep::Box3& box, const Camera& camera,
   const RayCastOptions& options = {});
+
+/// A lone model as the polygonal scene of `ictk render --mode mesh` (the reference the exact
+/// ray cast is compared with): its surface in `box` by dual contouring (Discretize/Surface.h,
+/// the surface `ictk mesh` makes) with edges of `featureSize` (0: 1/64 of the box's largest
+/// side), at options.time with options.parameters, shaded with vertex normals and painted by the
+/// attribute options.colours names (as rayCast) evaluated at each vertex. Throws as rayCast and
+/// contourSurface do.
+ScenePrimitives modelScene(const frep::Hypervolume& model, const frep::Box3& box,
+  double featureSize, const RayCastOptions& options = {});
 
 /// What a picture shows at one pixel (picking, seed 003 item 38).
 struct Pick
