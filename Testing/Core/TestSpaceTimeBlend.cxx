@@ -1103,3 +1103,52 @@ TEST(SpaceTimeBlend, TranslationAlongTimeCarriesTheFeature)
     }
   }
 }
+
+TEST(SpaceTimeBlend, ScalingAlongTimeStretchesTheTransition)
+{
+  // A disk of radius 0.6 becomes a bar 2.4 x 0.4. Scaling the space-time object along t about t0
+  // by s is the interval [t0, t0 + s (t1 - t0)]: t1 is an expression, here the model's T1. With
+  // s = 1 the slice at t = 2 is the bar; with s = 2 it is still between the two (and the bar
+  // comes at t = 3), while before t0 both are the disk.
+  auto signDiffers = [](const std::function<double(double, double)>& slice,
+                       const std::function<double(double, double)>& shape)
+  {
+    int differ = 0;
+    for (int j = 0; j < N; ++j)
+      for (int i = 0; i < N; ++i)
+      {
+        const double x = gridCoordinate(i), y = gridCoordinate(j), e = shape(x, y);
+        differ += std::abs(e) > 1e-9 && (slice(x, y) >= 0) != (e > 0);
+      }
+    return differ;
+  };
+  auto disk = [](double x, double y)
+  {
+    return 0.6 - std::hypot(x, y);
+  };
+  auto bar = [](double x, double y)
+  {
+    return std::min(1.2 - std::abs(x), 0.2 - std::abs(y));
+  };
+  for (const std::string t1 : { "2", "3" })
+  {
+    engine::DynamicModel m =
+      placedInTime("disk(0.6)", "rectangle(2.4, 0.4)", "u = 0;", "u = 0;", t1);
+    m.start();
+    m.advanceTo(1, 0.5);
+    EXPECT_EQ(signDiffers(morphSlice(m), disk), 0) << "T1 = " << t1;
+    m.advanceTo(2, 0.1);
+    const int atTwo = signDiffers(morphSlice(m), bar);
+    if (t1 == "2")
+    {
+      EXPECT_EQ(atTwo, 0);
+    }
+    else
+    {
+      EXPECT_GT(atTwo, 100) << "halfway through the stretched transition";
+      EXPECT_GT(signDiffers(morphSlice(m), disk), 100);
+      m.advanceTo(3, 0.1);
+      EXPECT_EQ(signDiffers(morphSlice(m), bar), 0);
+    }
+  }
+}
