@@ -867,10 +867,10 @@ TEST(SpaceTimeBlend, WarpMovesFeaturesAlongTime)
 TEST(SpaceTimeBlend, WarpKeepsTheSplitInOnePieceUntilItSeparates)
 {
   // Plain, the middle disk shrinks while the two far disks grow: the slices in the middle are
-  // empty (measured: 1 1 1 1 0 0 0 0 2 2 2 2 2 over the 13 times below). Warped (the automatic control points: ONE's centre, TWO's two centres; or the same
-  // pairs given), ONE is stretched toward both destinations while TWO's disks come from the
-  // centre: one component, then two, never anything else; the features sit on the moving
-  // nodes (+-1.5 u, 0).
+  // empty (measured: 1 1 1 1 0 0 0 0 2 2 2 2 2 over the 13 times below). Warped (the automatic
+  // control points: ONE's centre, TWO's two centres; or the same pairs given), ONE is stretched
+  // toward both destinations while TWO's disks come from the centre: one component, then two, never
+  // anything else; the features sit on the moving nodes (+-1.5 u, 0).
   for (const std::string after :
     { "", ", 0, 2, 0.5", ", 0, vec3(0, 0, 0), vec3(-1.5, 0, 0), vec3(0, 0, 0), vec3(1.5, 0, 0)" })
   {
