@@ -192,7 +192,7 @@ void ModelState::warpOf(
   const CellSpec::Operands& o = *c.operands;
   const Pos at = o.numbers[7]->pos;
   const std::string whose =
-    "the warp of " + c.name + " (spaceTimeBlendCells' arguments after " + "align): ";
+    "the warp of " + c.name + " (spaceTimeBlendCells' arguments after align): ";
   if (out.align > 0)
     fail(at, whose + "a warp and an alignment both move the operands; give align = 0 with a warp");
   if (args[0].type == Value::Type::Vec3)
@@ -224,7 +224,7 @@ void ModelState::warpOf(
         std::to_string(geometry::kMaxControlPoints) + ", it is " + std::to_string(count));
   if (!(separation >= 0) || !std::isfinite(separation))
     fail(o.numbers[8]->pos,
-      whose + "the separation of the control points is a length >= 0, " + "it is " +
+      whose + "the separation of the control points is a length >= 0, it is " +
         std::to_string(separation));
   out.warpCount = static_cast<int>(count);
   out.warpSeparation = separation;
