@@ -14,7 +14,9 @@
 #include "FRep/Hypervolume.h"
 #include "FRep/Operations.h"
 #include "FRep/Tape.h"
+#include "Geometry/PlacedShape.h"
 #include "Geometry/Queries.h"
+#include "Geometry/SpaceTimeWarp.h"
 #include "Lang/FRepXml.h"
 #include "Lang/HyperFun.h"
 #include "Lang/Icm.h"
@@ -618,4 +620,535 @@ TEST(SpaceTimeBlend, ThesisStbCellSamplesItsFourDimensionalFilm)
   EXPECT_GE(during, 10u);
   EXPECT_LE(m.value("STB_CELL.largestChange").number, 0.2);
   EXPECT_NEAR(m.value("STB_CELL.shapeVolume").number, Pi / 6, 1e-3 * Pi / 6);
+}
+
+// ---- Thesis 5.3.3: warps from control points, and the automatic control points of eq. (4). ----
+
+namespace
+{
+
+using ictk::geometry::PlacedShape;
+using ictk::geometry::PlacedShapePtr;
+using ictk::geometry::ShapePart;
+using ictk::geometry::Vec3;
+
+/// A disk of radius r centred at (x, y), placed.
+PlacedShapePtr diskAt(double r, double x, double y)
+{
+  auto s = std::make_shared<PlacedShape>();
+  s->cell = "disk";
+  s->dimension = 2;
+  ShapePart p;
+  p.kind = ShapePart::Kind::Disk;
+  p.radius = r;
+  s->parts.push_back(p);
+  s->place.b = { x, y, 0 };
+  return s;
+}
+
+PlacedShapePtr unionOf(PlacedShapePtr a, PlacedShapePtr b)
+{
+  auto s = std::make_shared<PlacedShape>();
+  s->cell = "union";
+  s->dimension = 2;
+  ShapePart p;
+  p.kind = ShapePart::Kind::Union;
+  p.operandA = std::move(a);
+  p.operandB = std::move(b);
+  s->parts.push_back(p);
+  return s;
+}
+
+double distance3(const Vec3& a, const Vec3& b)
+{
+  return std::sqrt(
+    (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+/// A disk of radius 0.5 at the origin becomes two disks of radius 0.3 at (+-1.5, 0) between t = 1
+/// and t = 2: one feature becomes two far away, plain blending breaks the slices into pieces.
+engine::DynamicModel diskToTwoDisks(const std::string& after)
+{
+  return engine::DynamicModel(ictk::lang::readIcm(R"(name = SPLIT;
+TIMESPANS { film : TIMESPAN(0, 3); }
+CELLS {
+  ONE { type = F-CELL; shape = disk(0.5); dim = 2D; domain = { -0.5, -0.5, 0.5, 0.5 }; }
+  TWO {
+    type = F-CELL;
+    shape = hyperfun {
+      two(x[2], a[1]) {
+        two = (0.3 - sqrt((x[1] + 1.5)^2 + x[2]^2)) | (0.3 - sqrt((x[1] - 1.5)^2 + x[2]^2));
+      }
+    }
+    dim = 2D;
+    domain = { -2, -0.5, 2, 0.5 };
+  }
+  MORPH {
+    type = T-CELL;
+    shape = spaceTimeBlendCells(ONE, TWO, 1, 2, 0.5, 1, 1, 0.2)" +
+      after + R"();
+    dim = 3D;
+    domain = { -2, -1.5, 2, 1.5 };
+  }
+}
+K { CELLS { MORPH; } }
+)",
+    "split.icm"));
+}
+
+constexpr int M = 161; // grid points per axis over [-2, 2] for the split example
+double splitCoordinate(int i)
+{
+  return -2.0 + 4.0 * i / (M - 1);
+}
+
+/// 4-connected components of {f >= 0} on the M x M grid over [-2, 2]^2.
+int splitComponents(const std::function<double(double, double)>& f)
+{
+  std::vector<int> label(M * M, 0);
+  std::vector<char> inside(M * M);
+  for (int j = 0; j < M; ++j)
+    for (int i = 0; i < M; ++i)
+      inside[j * M + i] = f(splitCoordinate(i), splitCoordinate(j)) >= 0;
+  int count = 0;
+  for (int start = 0; start < M * M; ++start)
+  {
+    if (!inside[start] || label[start])
+      continue;
+    ++count;
+    std::vector<int> stack{ start };
+    label[start] = count;
+    while (!stack.empty())
+    {
+      const int k = stack.back();
+      stack.pop_back();
+      const int i = k % M, j = k / M;
+      const int next[4][2] = { { i - 1, j }, { i + 1, j }, { i, j - 1 }, { i, j + 1 } };
+      for (const auto& n : next)
+      {
+        if (n[0] < 0 || n[0] >= M || n[1] < 0 || n[1] >= M)
+          continue;
+        const int m = n[1] * M + n[0];
+        if (inside[m] && !label[m])
+        {
+          label[m] = count;
+          stack.push_back(m);
+        }
+      }
+    }
+  }
+  return count;
+}
+
+} // namespace
+
+TEST(SpaceTimeBlend, ThickFeaturesAreTheMaximaOfTheDistanceTransform)
+{
+  // Union of the disks r = 1 at (0, 0) and r = 0.5 at (3, 0) (the spec's Scenario E): the
+  // maxima are the centres, at depths 1 and 0.5. The grid: 128 cells over the 4.5-wide box.
+  const double h = 4.5 / 128;
+  const PlacedShapePtr disks = unionOf(diskAt(1, 0, 0), diskAt(0.5, 3, 0));
+  std::vector<double> depths;
+  std::vector<Vec3> points = ictk::geometry::thickFeatures(*disks, 2, 0.5, &depths);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_LE(distance3(points[0], { 0, 0, 0 }), std::sqrt(2.0) * h) << points[0][0];
+  EXPECT_LE(distance3(points[1], { 3, 0, 0 }), std::sqrt(2.0) * h) << points[1][0];
+  EXPECT_NEAR(depths[0], 1.0, h);
+  EXPECT_NEAR(depths[1], 0.5, h);
+  // One point: the deepest. Three asked: the big disk has no other maximum 0.5 away, but the
+  // small one's is taken only once either way.
+  points = ictk::geometry::thickFeatures(*disks, 1, 0.5);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_LE(distance3(points[0], { 0, 0, 0 }), std::sqrt(2.0) * h);
+  EXPECT_EQ(ictk::geometry::thickFeatures(*disks, 3, 0.5).size(), 2u);
+
+  // A 4 x 1 rectangle: its medial axis is the segment |x| <= 1.5, y = 0, where the distance is
+  // 0.5 all along (a flat ridge); three points at least 1 apart lie on it.
+  auto rectangle = std::make_shared<PlacedShape>();
+  rectangle->cell = "rectangle";
+  rectangle->dimension = 2;
+  ShapePart r;
+  r.kind = ShapePart::Kind::Rectangle;
+  r.size = { 4, 1, 0 };
+  rectangle->parts.push_back(r);
+  const double hr = 4.0 / 128;
+  points = ictk::geometry::thickFeatures(*rectangle, 3, 1.0, &depths);
+  ASSERT_EQ(points.size(), 3u);
+  for (std::size_t i = 0; i < points.size(); ++i)
+  {
+    EXPECT_LE(std::abs(points[i][1]), hr) << i;
+    EXPECT_LE(std::abs(points[i][0]), 1.5 + hr) << i;
+    EXPECT_NEAR(depths[i], 0.5, hr) << i;
+    for (std::size_t j = 0; j < i; ++j)
+      EXPECT_GE(distance3(points[i], points[j]), 1.0) << i << " " << j;
+  }
+
+  // A ball of radius 1 centred at (0.2, 0, -0.3): one maximum, the centre (64 cells over 2).
+  auto ball = std::make_shared<PlacedShape>();
+  ball->cell = "ball";
+  ball->dimension = 3;
+  ShapePart b;
+  b.kind = ShapePart::Kind::Sphere;
+  b.radius = 1;
+  ball->parts.push_back(b);
+  ball->place.b = { 0.2, 0, -0.3 };
+  points = ictk::geometry::thickFeatures(*ball, 2, 0.5, &depths);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_LE(distance3(points[0], { 0.2, 0, -0.3 }), std::sqrt(3.0) * 2.0 / 64);
+  // The depth: the cell centre may be sqrt(3) h / 2 off the centre, and the boundary up to h / 2
+  // off the half-cell correction.
+  EXPECT_NEAR(depths[0], 1.0, 2 * 2.0 / 64);
+
+  EXPECT_THROW(ictk::geometry::thickFeatures(*ball, 0, 0.5), std::invalid_argument);
+  EXPECT_THROW(ictk::geometry::thickFeatures(*ball, 1, -1), std::invalid_argument);
+}
+
+TEST(SpaceTimeBlend, ControlPointsArePairedByLeastTotalDistance)
+{
+  // Crossing pairs would cost 1.1 + 0.9 = 2.0; the straight ones 0.1 + 0.1.
+  auto pairs = ictk::geometry::pairControlPoints(
+    { { 0, 0, 0 }, { 1, 0, 0 } }, { { 1.1, 0, 0 }, { 0.1, 0, 0 } });
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[0].destination[0], 0.1);
+  EXPECT_EQ(pairs[1].destination[0], 1.1);
+  // One source, two destinations: the source goes to both (the first by the matching, the
+  // other as its nearest source).
+  pairs = ictk::geometry::pairControlPoints({ { 0, 0, 0 } }, { { -1.5, 0, 0 }, { 1.5, 0, 0 } });
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[0].source[0], 0.0);
+  EXPECT_EQ(pairs[1].source[0], 0.0);
+  EXPECT_EQ(pairs[0].destination[0] + pairs[1].destination[0], 0.0);
+  EXPECT_EQ(std::abs(pairs[0].destination[0]), 1.5);
+  // Three sources, one destination: all three go there.
+  pairs =
+    ictk::geometry::pairControlPoints({ { 0, 0, 0 }, { 1, 0, 0 }, { 2, 0, 0 } }, { { 5, 0, 0 } });
+  ASSERT_EQ(pairs.size(), 3u);
+  for (const auto& p : pairs)
+    EXPECT_EQ(p.destination[0], 5.0);
+  EXPECT_THROW(ictk::geometry::pairControlPoints(std::vector<Vec3>(9), { { 0, 0, 0 } }),
+    std::invalid_argument);
+}
+
+TEST(SpaceTimeBlend, WarpMovesFeaturesAlongTime)
+{
+  // The warp at progress u: cellA at p + D_A(p), cellB at p + D_B(p); at a node m_i = s_i +
+  // u (d_i - s_i) they read s_i and d_i exactly, and between nodes D is Shepard's average.
+  const std::vector<ictk::geometry::ControlPair> pairs = { { { 0, 0, 0 }, { -1.5, 0, 0 } },
+    { { 0, 0, 0 }, { 1.5, 0, 0 } } };
+  const auto w = ictk::geometry::SpaceTimeWarp::at(pairs, 0.4);
+  ASSERT_EQ(w.nodes.size(), 2u);
+  EXPECT_DOUBLE_EQ(w.nodes[1][0], 0.6);
+  for (std::size_t i = 0; i < 2; ++i)
+  {
+    const Vec3 a = w.shift(w.shiftA, w.nodes[i]), b = w.shift(w.shiftB, w.nodes[i]);
+    EXPECT_DOUBLE_EQ(w.nodes[i][0] + a[0], 0.0);
+    EXPECT_DOUBLE_EQ(w.nodes[i][0] + b[0], pairs[i].destination[0]);
+  }
+  // At (0, 1): distances equal, the mean of the shifts, 0.
+  EXPECT_NEAR(w.shift(w.shiftA, { 0, 1, 0 })[0], 0.0, 1e-15);
+  // At (1, 0.5): weights 1 / (0.4^2 + 0.25) and 1 / (1.6^2 + 0.25), by hand.
+  const double w1 = 1 / (0.16 + 0.25), w0 = 1 / (2.56 + 0.25);
+  EXPECT_NEAR(w.shift(w.shiftA, { 1, 0.5, 0 })[0], (w0 * 0.6 + w1 * -0.6) / (w0 + w1), 1e-14);
+  // The Jacobian against central differences.
+  double j[9];
+  const Vec3 p{ 0.3, 0.7, 0 };
+  w.shift(w.shiftB, p, j);
+  for (int c = 0; c < 2; ++c)
+  {
+    Vec3 lo = p, hi = p;
+    lo[c] -= 1e-6;
+    hi[c] += 1e-6;
+    for (int row = 0; row < 2; ++row)
+      EXPECT_NEAR(
+        j[3 * row + c], (w.shift(w.shiftB, hi)[row] - w.shift(w.shiftB, lo)[row]) / 2e-6, 1e-6);
+  }
+}
+
+TEST(SpaceTimeBlend, WarpKeepsTheSplitInOnePieceUntilItSeparates)
+{
+  // Plain, the middle disk shrinks while the two far disks grow: the slices in the middle are
+  // empty (measured: 1 1 1 1 0 0 0 0 2 2 2 2 2 over the 13 times below). Warped (the automatic
+  // control points: ONE's centre, TWO's two centres; or the same pairs given), ONE is stretched
+  // toward both destinations while TWO's disks come from the centre: one component, then two, never
+  // anything else; the features sit on the moving nodes (+-1.5 u, 0).
+  for (const std::string after :
+    { "", ", 0, 2, 0.5", ", 0, vec3(0, 0, 0), vec3(-1.5, 0, 0), vec3(0, 0, 0), vec3(1.5, 0, 0)" })
+  {
+    engine::DynamicModel m = diskToTwoDisks(after);
+    m.start();
+    std::vector<int> counts;
+    for (int k = 0; k <= 12; ++k)
+    {
+      const double t = k == 0 ? 0.5 : k == 12 ? 2.5 : 1 + 0.1 * (k - 1) + 0.05; // 1.05 .. 2.05
+      m.advanceTo(t, 0.5);
+      const auto slice = valueOf(*m.cells()[0].shape);
+      counts.push_back(splitComponents(slice));
+      if (k == 0 || k == 12)
+      {
+        // Before t0 ONE, after t1 TWO: the warp is the identity there.
+        int differ = 0;
+        for (int jj = 0; jj < M; ++jj)
+          for (int i = 0; i < M; ++i)
+          {
+            const double x = splitCoordinate(i), y = splitCoordinate(jj);
+            const double e = k == 0
+              ? 0.5 - std::hypot(x, y)
+              : std::max(0.3 - std::hypot(x + 1.5, y), 0.3 - std::hypot(x - 1.5, y));
+            differ += std::abs(e) > 1e-9 && (slice(x, y) >= 0) != (e > 0);
+          }
+        EXPECT_EQ(differ, 0) << "'" << after << "' t = " << t;
+      }
+      else if (!after.empty() && t < 2)
+      {
+        const double u = t - 1;
+        EXPECT_GT(slice(1.5 * u, 0), 0) << "'" << after << "' t = " << t;
+        EXPECT_GT(slice(-1.5 * u, 0), 0) << "'" << after << "' t = " << t;
+      }
+    }
+    std::string seen;
+    for (int c : counts)
+      seen += std::to_string(c) + " ";
+    EXPECT_EQ(counts.front(), 1) << seen;
+    EXPECT_EQ(counts.back(), 2) << seen;
+    if (after.empty())
+    {
+      EXPECT_TRUE(std::any_of(counts.begin(), counts.end(), [](int c) { return c == 0 || c > 2; }))
+        << "plain: " << seen;
+    }
+    else
+    {
+      // 1 ... 1 2 ... 2: monotone, never empty, never more than the destination's two.
+      EXPECT_TRUE(std::is_sorted(counts.begin(), counts.end())) << after << ": " << seen;
+      for (int c : counts)
+      {
+        EXPECT_GE(c, 1) << after << ": " << seen;
+        EXPECT_LE(c, 2) << after << ": " << seen;
+      }
+    }
+  }
+}
+
+TEST(SpaceTimeBlend, MalformedWarpsAreRefusedAtTheirPlace)
+{
+  struct Case
+  {
+    std::string after, words;
+  };
+  const Case cases[] = {
+    { ", 0, vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 0, 0)", "pairs" },
+    { ", 0, vec3(0, 0, 0), vec3(1, 0, 0)", "2 pairs or more" },
+    { ", 0, vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 0, 0), 3", "argument 13" },
+    { ", 1, 2, 0.5", "align = 0" },
+    { ", 0, 9, 0.5", "from 1 to 8" },
+    { ", 0, 1.5, 0.5", "whole number" },
+    { ", 0, 2, -1", "separation" },
+    { ", 0, 2", "two numbers" },
+  };
+  for (const Case& c : cases)
+  {
+    try
+    {
+      diskToTwoDisks(c.after);
+      ADD_FAILURE() << c.after << " was accepted";
+    }
+    catch (const engine::ModelError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find("split.icm:17:"), std::string::npos) << e.what();
+      EXPECT_NE(e.message.find(c.words), std::string::npos) << e.message;
+    }
+  }
+}
+
+// ---- Thesis 5.3.2, the manual variant: the operands' own time-dependent placements. ----
+
+namespace
+{
+
+/// cellA and cellB, both placed by `placeA` / `placeB` (reaction statements run at every step,
+/// u the transition's progress), blended between t = 1 and t = 2.
+engine::DynamicModel placedInTime(const std::string& shapeA, const std::string& shapeB,
+  const std::string& placeA, const std::string& placeB, const std::string& t1 = "2")
+{
+  auto cell = [](const std::string& name, const std::string& shape, const std::string& place)
+  {
+    return "  " + name + " {\n    type = F-CELL; shape = " + shape +
+      "; dim = 2D; domain = { -1.5, -1.5, 1.5, 1.5 };\n" +
+      "    REACTIONS {\n      update(REAL globalT, REAL localT, REAL lifeT, REAL dt)\n      {\n" +
+      "        REAL u = min(max(globalT - 1, 0) / (T1 - 1), 1);\n        " + place +
+      "\n      }\n    }\n  }\n";
+  };
+  return engine::DynamicModel(ictk::lang::readIcm("name = PLACED;\nparameters { T1 : REAL(" + t1 +
+      "); }\nTIMESPANS { film : TIMESPAN(0, 5); }\nCELLS {\n" + cell("A", shapeA, placeA) +
+      cell("B", shapeB, placeB) +
+      "  MORPH {\n    type = T-CELL;\n    shape = spaceTimeBlendCells(A, B, 1, T1, 0.5, 1, 1, "
+      "0.2);\n    dim = 3D;\n    domain = { -2, -2, 2, 2 };\n  }\n}\n"
+      "K { CELLS { MORPH; A; B; } }\n",
+    "placed.icm"));
+}
+
+std::function<double(double, double)> morphSlice(const engine::DynamicModel& m)
+{
+  for (const engine::CellState& c : m.cells())
+    if (c.name == "MORPH")
+      return valueOf(*c.shape);
+  ADD_FAILURE() << "no MORPH";
+  return [](double, double)
+  {
+    return -1.0;
+  };
+}
+
+/// The inside's area, centroid, and principal direction (radians, of the larger second moment)
+/// and the ratio of the second moments, on the N x N grid over [-1.5, 1.5]^2.
+struct Moments
+{
+  double area = 0, cx = 0, cy = 0, angle = 0, ratio = 0;
+};
+
+Moments momentsOf(const std::function<double(double, double)>& f)
+{
+  std::vector<std::pair<double, double>> in;
+  for (int j = 0; j < N; ++j)
+    for (int i = 0; i < N; ++i)
+      if (f(gridCoordinate(i), gridCoordinate(j)) >= 0)
+        in.emplace_back(gridCoordinate(i), gridCoordinate(j));
+  Moments r;
+  if (in.empty())
+    return r;
+  const double h = 3.0 / (N - 1);
+  r.area = static_cast<double>(in.size()) * h * h;
+  for (const auto& [x, y] : in)
+  {
+    r.cx += x / static_cast<double>(in.size());
+    r.cy += y / static_cast<double>(in.size());
+  }
+  double xx = 0, yy = 0, xy = 0;
+  for (const auto& [x, y] : in)
+  {
+    xx += (x - r.cx) * (x - r.cx);
+    yy += (y - r.cy) * (y - r.cy);
+    xy += (x - r.cx) * (y - r.cy);
+  }
+  r.angle = 0.5 * std::atan2(2 * xy, xx - yy);
+  const double mean = 0.5 * (xx + yy), dev = std::hypot(0.5 * (xx - yy), xy);
+  r.ratio = (mean + dev) / std::max(mean - dev, 1e-12);
+  return r;
+}
+
+} // namespace
+
+TEST(SpaceTimeBlend, RotationAboutTheTimeAxisTurnsTheBar)
+{
+  // A bar 2 x 0.4 becomes the same bar turned by 90 degrees. Plain, the middle slice is both bars
+  // at once (a cross: equal second moments). Both operands turned by (pi / 2) u about the time
+  // axis (their rotation.z set by a reaction), each slice is one bar at the angle (pi / 2) u.
+  const std::string bar = "rectangle(2, 0.4)";
+  engine::DynamicModel plain =
+    placedInTime(bar, bar, "rotation.z = 0;", "rotation.z = 1.5707963267948966;");
+  plain.start();
+  plain.advanceTo(1.5, 0.5);
+  const Moments cross = momentsOf(morphSlice(plain));
+  EXPECT_GT(cross.area, 0.5);
+  EXPECT_LT(cross.ratio, 1.2) << "plain: a cross, no direction";
+
+  const std::string turn = "rotation.z = 1.5707963267948966 * u;";
+  engine::DynamicModel turned = placedInTime(bar, bar, turn, turn);
+  turned.start();
+  for (double t : { 0.5, 1.1, 1.25, 1.5, 1.75, 1.9, 2.5 })
+  {
+    turned.advanceTo(t, 0.05);
+    const auto slice = morphSlice(turned);
+    const Moments mo = momentsOf(slice);
+    const double u = std::clamp(t - 1, 0.0, 1.0);
+    double angle = mo.angle;
+    if (u > 0.75 && angle < 0)
+      angle += Pi; // atan2's branch: a bar at 90 degrees is also at -90
+    EXPECT_NEAR(angle, 0.5 * Pi * u, 2 * Pi / 180) << "t = " << t;
+    EXPECT_GT(mo.ratio, 4.0) << "t = " << t << ": a bar";
+    EXPECT_EQ(components(slice), 1) << "t = " << t;
+    EXPECT_NEAR(mo.cx, 0, 1e-9);
+    EXPECT_NEAR(mo.cy, 0, 1e-9);
+    if (t < 1 || t > 2)
+    {
+      // The bar itself, 2 x 0.4, counted on the same grid.
+      const double grid =
+        gridArea([](double x, double y) { return std::min(1 - std::abs(x), 0.2 - std::abs(y)); });
+      EXPECT_NEAR(grid, 0.8, 0.07);
+      EXPECT_NEAR(mo.area, grid, 1e-9) << "t = " << t;
+    }
+  }
+}
+
+TEST(SpaceTimeBlend, TranslationAlongTimeCarriesTheFeature)
+{
+  // Two disks of radius 0.3 at x = -1 and x = 1 (the far disks above, where plain blending
+  // loses the shape): both translated to x = -1 + 2u, a feature moved along t, each slice is one
+  // disk centred there.
+  engine::DynamicModel m = placedInTime(
+    "disk(0.3)", "disk(0.3)", "translation.x = -1 + 2 * u;", "translation.x = -1 + 2 * u;");
+  m.start();
+  for (double t : { 0.5, 1.1, 1.3, 1.5, 1.7, 1.9, 2.5 })
+  {
+    m.advanceTo(t, 0.05);
+    const auto slice = morphSlice(m);
+    const Moments mo = momentsOf(slice);
+    const double u = std::clamp(t - 1, 0.0, 1.0);
+    EXPECT_EQ(components(slice), 1) << "t = " << t;
+    EXPECT_NEAR(mo.cx, -1 + 2 * u, 0.01) << "t = " << t;
+    EXPECT_NEAR(mo.cy, 0, 0.01) << "t = " << t;
+    EXPECT_GT(mo.area, 0.2) << "t = " << t;
+    if (t < 1 || t > 2)
+    {
+      EXPECT_NEAR(mo.area, Pi * 0.09, 0.01) << "t = " << t;
+    }
+  }
+}
+
+TEST(SpaceTimeBlend, ScalingAlongTimeStretchesTheTransition)
+{
+  // A disk of radius 0.6 becomes a bar 2.4 x 0.4. Scaling the space-time object along t about t0
+  // by s is the interval [t0, t0 + s (t1 - t0)]: t1 is an expression, here the model's T1. With
+  // s = 1 the slice at t = 2 is the bar; with s = 2 it is still between the two (and the bar
+  // comes at t = 3), while before t0 both are the disk.
+  auto signDiffers = [](const std::function<double(double, double)>& slice,
+                       const std::function<double(double, double)>& shape)
+  {
+    int differ = 0;
+    for (int j = 0; j < N; ++j)
+      for (int i = 0; i < N; ++i)
+      {
+        const double x = gridCoordinate(i), y = gridCoordinate(j), e = shape(x, y);
+        differ += std::abs(e) > 1e-9 && (slice(x, y) >= 0) != (e > 0);
+      }
+    return differ;
+  };
+  auto disk = [](double x, double y)
+  {
+    return 0.6 - std::hypot(x, y);
+  };
+  auto bar = [](double x, double y)
+  {
+    return std::min(1.2 - std::abs(x), 0.2 - std::abs(y));
+  };
+  for (const std::string t1 : { "2", "3" })
+  {
+    engine::DynamicModel m =
+      placedInTime("disk(0.6)", "rectangle(2.4, 0.4)", "u = 0;", "u = 0;", t1);
+    m.start();
+    m.advanceTo(1, 0.5);
+    EXPECT_EQ(signDiffers(morphSlice(m), disk), 0) << "T1 = " << t1;
+    m.advanceTo(2, 0.1);
+    const int atTwo = signDiffers(morphSlice(m), bar);
+    if (t1 == "2")
+    {
+      EXPECT_EQ(atTwo, 0);
+    }
+    else
+    {
+      EXPECT_GT(atTwo, 100) << "halfway through the stretched transition";
+      EXPECT_GT(signDiffers(morphSlice(m), disk), 100);
+      m.advanceTo(3, 0.1);
+      EXPECT_EQ(signDiffers(morphSlice(m), bar), 0);
+    }
+  }
 }

@@ -121,6 +121,9 @@ void ModelState::build()
       c.operands->amount = n.amount;
       c.operands->spaceTime = n.spaceTime;
       c.operands->align = n.align;
+      c.operands->pairs = n.pairs;
+      c.operands->warpCount = n.warpCount;
+      c.operands->warpSeparation = n.warpSeparation;
     }
 }
 
@@ -132,10 +135,16 @@ OperandNumbers ModelState::evaluateOperands(const CellSpec& c, std::size_t insta
   double* slots[] = { &out.spaceTime.t0, &out.spaceTime.t1, &out.spaceTime.a0, &out.spaceTime.a1,
     &out.spaceTime.a2, &out.spaceTime.a3 };
   EngineScope scope(*this, c.name, instance);
+  std::vector<Value> warpArguments;
   for (std::size_t i = 0; i < o.numbers.size(); ++i)
   {
     const Expr& e = *o.numbers[i];
     const Value v = interpreter.evaluate(e, scope);
+    if (spaceTimeBlend && i >= 7)
+    {
+      warpArguments.push_back(v);
+      continue;
+    }
     if (!v.isNumber() || !std::isfinite(v.number))
       fail(e.pos,
         "argument " + std::to_string(i + 3) + " of the shape of " + c.name +
@@ -159,6 +168,8 @@ OperandNumbers ModelState::evaluateOperands(const CellSpec& c, std::size_t insta
       out.amount = v.number;
     }
   }
+  if (!warpArguments.empty())
+    warpOf(c, warpArguments, out);
   if (spaceTimeBlend)
   {
     try
@@ -171,6 +182,52 @@ OperandNumbers ModelState::evaluateOperands(const CellSpec& c, std::size_t insta
     }
   }
   return out;
+}
+
+void ModelState::warpOf(
+  const CellSpec& c, const std::vector<Value>& args, OperandNumbers& out) const
+{
+  // spaceTimeBlendCells' arguments after `align` (thesis 5.3.3): vec3 source, destination pairs,
+  // or the count and separation of the automatic control points.
+  const CellSpec::Operands& o = *c.operands;
+  const Pos at = o.numbers[7]->pos;
+  const std::string whose =
+    "the warp of " + c.name + " (spaceTimeBlendCells' arguments after align): ";
+  if (out.align > 0)
+    fail(at, whose + "a warp and an alignment both move the operands; give align = 0 with a warp");
+  if (args[0].type == Value::Type::Vec3)
+  {
+    if (args.size() % 2 != 0 || args.size() < 4)
+      fail(at,
+        whose + "control points come in pairs, source then destination, 2 pairs or more; " +
+          "there are " + std::to_string(args.size()) + " points");
+    for (std::size_t i = 0; i < args.size(); i += 2)
+    {
+      for (std::size_t k = i; k < i + 2; ++k)
+        if (args[k].type != Value::Type::Vec3 || !std::isfinite(args[k].vec[0]) ||
+          !std::isfinite(args[k].vec[1]) || !std::isfinite(args[k].vec[2]))
+          fail(o.numbers[7 + k]->pos,
+            whose + "argument " + std::to_string(k + 10) +
+              " must be a finite point vec3(x, y, z) like the others");
+      out.pairs.push_back({ args[i].vec, args[i + 1].vec });
+    }
+    return;
+  }
+  if (args.size() != 2 || !args[0].isNumber() || !args[1].isNumber())
+    fail(at,
+      whose + "either vec3 source, destination pairs or two numbers, the count and the " +
+        "separation of the automatic control points");
+  const double count = args[0].number, separation = args[1].number;
+  if (!(count >= 1 && count <= geometry::kMaxControlPoints) || count != std::floor(count))
+    fail(at,
+      whose + "the number of automatic control points is a whole number from 1 to " +
+        std::to_string(geometry::kMaxControlPoints) + ", it is " + std::to_string(count));
+  if (!(separation >= 0) || !std::isfinite(separation))
+    fail(o.numbers[8]->pos,
+      whose + "the separation of the control points is a length >= 0, it is " +
+        std::to_string(separation));
+  out.warpCount = static_cast<int>(count);
+  out.warpSeparation = separation;
 }
 
 void ModelState::checkSpaceTimeBlends() const

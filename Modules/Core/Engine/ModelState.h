@@ -100,7 +100,14 @@ struct CellSpec
     double amount = 0.0;
     frep::SpaceTimeBlendParameters spaceTime; ///< SpaceTimeBlend only
     double align = 0.0;                       ///< SpaceTimeBlend only (OperandNumbers::align)
-    Pos pos;                                  ///< the constructor's call
+    std::vector<geometry::ControlPair> pairs; ///< SpaceTimeBlend only (OperandNumbers::pairs)
+    int warpCount = 0;                        ///< SpaceTimeBlend only (OperandNumbers)
+    double warpSeparation = 0.0;              ///< SpaceTimeBlend only (OperandNumbers)
+    /// The automatic control pairs found for the operands as they were (a hash of their
+    /// versions and placements): the distance transforms are redone only when they change.
+    mutable std::uint64_t pairedFor = 0;
+    mutable std::vector<geometry::ControlPair> autoPairs;
+    Pos pos; ///< the constructor's call
   };
   std::optional<Operands> operands;
   /// loadMesh("file", "animation"): a skinned mesh whose part `meshPart` is posed by the
@@ -173,6 +180,12 @@ struct OperandNumbers
   /// spaceTimeBlendCells' ninth number: how far the automatic space-time alignment moves each
   /// operand toward the other's bounding domain (thesis 5.3.2 L3108; 0 = plain blending).
   double align = 0.0;
+  /// spaceTimeBlendCells' warp (thesis 5.3.3, Geometry/SpaceTimeWarp.h): the control pairs
+  /// given as vec3 source, destination arguments after align, or, when warpCount > 0, that many
+  /// automatic control points of each operand at least warpSeparation apart, paired.
+  std::vector<geometry::ControlPair> pairs;
+  int warpCount = 0;
+  double warpSeparation = 0.0;
 };
 
 /// The structural state: what the parameter table cannot hold. Copied with every snapshot.
@@ -253,13 +266,21 @@ struct ModelState
   /// The numbers of cell c's blend-like shape evaluated in its scope within `instance` (kNone:
   /// the model's start); fails at the place of one that is not a number or out of range.
   OperandNumbers evaluateOperands(const CellSpec& c, std::size_t instance);
+  /// Reads spaceTimeBlendCells' warp arguments (those after align) into `out`; refuses them at
+  /// their place when malformed.
+  void warpOf(const CellSpec& c, const std::vector<Value>& args, OperandNumbers& out) const;
+  /// The control pairs of a space-time blend's warp for its operands a and b as placed now:
+  /// the given pairs, or the automatic ones (thick features of each operand, paired).
+  std::vector<geometry::ControlPair> controlPairs(const CellSpec& c, const OperandNumbers& n,
+    const PlacedShapePtr& a, const PlacedShapePtr& b, int depth) const;
   /// The numbers of cell c's blend-like shape at the current step.
   OperandNumbers operandNumbersOf(const CellSpec& c) const
   {
     const auto it = s.operandNumbers.find(c.name);
     return it != s.operandNumbers.end()
       ? it->second
-      : OperandNumbers{ c.operands->amount, c.operands->spaceTime, c.operands->align };
+      : OperandNumbers{ c.operands->amount, c.operands->spaceTime, c.operands->align,
+          c.operands->pairs, c.operands->warpCount, c.operands->warpSeparation };
   }
   void buildAnimations();
   void buildEvents();

@@ -301,6 +301,34 @@ void ModelState::alignInSpaceTime(
   a = movedA;
 }
 
+std::vector<geometry::ControlPair> ModelState::controlPairs(const CellSpec& c,
+  const OperandNumbers& n, const PlacedShapePtr& a, const PlacedShapePtr& b, int depth) const
+{
+  if (n.warpCount == 0)
+    return n.pairs;
+  // The thick features depend on the operands' shapes and placements only, not on time: found
+  // again only when those change.
+  std::uint64_t key = mix(bitsOf(n.warpCount), bitsOf(n.warpSeparation));
+  for (const std::string& o : { c.operands->a, c.operands->b })
+  {
+    key = mix(key, versionOf(o, depth + 1));
+    const Affine placed = place(o);
+    for (double d : placed.a)
+      key = mix(key, bitsOf(d));
+    for (double d : placed.b)
+      key = mix(key, bitsOf(d));
+  }
+  key |= 1; // never 0, the unset key
+  if (key != c.operands->pairedFor)
+  {
+    c.operands->autoPairs =
+      geometry::pairControlPoints(geometry::thickFeatures(*a, n.warpCount, n.warpSeparation),
+        geometry::thickFeatures(*b, n.warpCount, n.warpSeparation));
+    c.operands->pairedFor = key;
+  }
+  return c.operands->autoPairs;
+}
+
 PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
 {
   if (depth > static_cast<int>(cells.size()))
@@ -322,7 +350,8 @@ PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
     {
       if (n.align > 0)
         alignInSpaceTime(a, b, n, shapeTime());
-      part = geometry::spaceTimeBlendPart(a, b, n.spaceTime, shapeTime());
+      part = geometry::spaceTimeBlendPart(
+        a, b, n.spaceTime, shapeTime(), controlPairs(c, n, a, b, depth));
     }
     part.kind = c.operands->kind;
     part.operandA = a;
@@ -356,9 +385,13 @@ std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
   // A blend or union lives in world coordinates: it changes when an operand moves, and when its
   // numbers change.
   const OperandNumbers n = operandNumbersOf(c);
-  for (double d : { n.amount, n.spaceTime.t0, n.spaceTime.t1, n.spaceTime.a0, n.spaceTime.a1,
-         n.spaceTime.a2, n.spaceTime.a3, n.align })
+  for (double d :
+    { n.amount, n.spaceTime.t0, n.spaceTime.t1, n.spaceTime.a0, n.spaceTime.a1, n.spaceTime.a2,
+      n.spaceTime.a3, n.align, n.warpSeparation, static_cast<double>(n.warpCount) })
     v = mix(v, bitsOf(d));
+  for (const geometry::ControlPair& p : n.pairs)
+    for (int k = 0; k < 3; ++k)
+      v = mix(mix(v, bitsOf(p.source[k])), bitsOf(p.destination[k]));
   for (const std::string& o : { c.operands->a, c.operands->b })
   {
     v = mix(v, versionOf(o, depth + 1));

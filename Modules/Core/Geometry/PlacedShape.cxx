@@ -384,8 +384,8 @@ bool Affine::isIdentity() const
   return a == std::array<double, 9>{ 1, 0, 0, 0, 1, 0, 0, 0, 1 } && b == Vec3{ 0, 0, 0 };
 }
 
-ShapePart spaceTimeBlendPart(
-  PlacedShapePtr a, PlacedShapePtr b, const frep::SpaceTimeBlendParameters& p, double time)
+ShapePart spaceTimeBlendPart(PlacedShapePtr a, PlacedShapePtr b,
+  const frep::SpaceTimeBlendParameters& p, double time, const std::vector<ControlPair>& pairs)
 {
   ShapePart part;
   part.kind = ShapePart::Kind::SpaceTimeBlend;
@@ -395,6 +395,7 @@ ShapePart spaceTimeBlendPart(
   part.time = time;
   part.blend = frep::tapeField(frep::Tape::compile(
     frep::spaceTimeBlendExpr(frep::Expr::x(), frep::Expr::y(), frep::Expr(time), p)));
+  part.warp = SpaceTimeWarp::at(pairs, std::clamp((time - p.t0) / (p.t1 - p.t0), 0.0, 1.0));
   return part;
 }
 
@@ -469,7 +470,13 @@ frep::Box3 PlacedShape::worldBounds() const
         const double bump = p.kind == ShapePart::Kind::Blend ? p.amount
           : p.kind == ShapePart::Kind::SpaceTimeBlend        ? std::abs(p.spaceTime.a0)
                                                              : 0.0;
-        add(padded(joinBoxes(p.operandA->worldBounds(), p.operandB->worldBounds()), 2 * bump));
+        // A warped operand is seen up to its largest displacement away.
+        double reach = 0;
+        for (const auto* shifts : { &p.warp.shiftA, &p.warp.shiftB })
+          for (const Vec3& d : *shifts)
+            reach = std::max(reach, frep::norm(d));
+        add(padded(
+          joinBoxes(p.operandA->worldBounds(), p.operandB->worldBounds()), 2 * bump + reach));
         break;
       }
       default:

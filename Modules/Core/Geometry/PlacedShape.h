@@ -16,6 +16,7 @@
 #include "FRep/Field.h"
 #include "FRep/Operations.h"
 #include "FRep/Vector.h"
+#include "Geometry/SpaceTimeWarp.h"
 
 #include <array>
 #include <cstdint>
@@ -96,6 +97,9 @@ struct ShapePart
   frep::SpaceTimeBlendParameters spaceTime;
   double time = 0.0;
   frep::FieldPtr blend;
+  /// SpaceTimeBlend: the warp of the operands at `time` (thesis 5.3.3; SpaceTimeWarp.h): cellA
+  /// is evaluated at p + warp.shift(warp.shiftA, p), cellB likewise; empty: no warp.
+  SpaceTimeWarp warp;
 };
 
 /// Blend, Union and SpaceTimeBlend parts are made of two other cells' placed shapes (world
@@ -108,9 +112,11 @@ inline bool combinesCells(const ShapePart& p)
 
 /// The SpaceTimeBlend part of two placed shapes: the cross-section at `time` of their space-time
 /// blend with parameters `p` (frep::spaceTimeBlendExpr; throws std::invalid_argument for bad
-/// parameters). `bounds` is left empty.
-ShapePart spaceTimeBlendPart(
-  PlacedShapePtr a, PlacedShapePtr b, const frep::SpaceTimeBlendParameters& p, double time);
+/// parameters). `bounds` is left empty. With control `pairs` the operands are warped so that
+/// each source feature of `a` travels to its destination in `b` during the transition
+/// (SpaceTimeWarp.h, thesis 5.3.3).
+ShapePart spaceTimeBlendPart(PlacedShapePtr a, PlacedShapePtr b,
+  const frep::SpaceTimeBlendParameters& p, double time, const std::vector<ControlPair>& pairs = {});
 
 /// A cell's shape placed in the world.
 struct PlacedShape

@@ -45,6 +45,52 @@ double operandValue(double f)
   return std::isnan(f) ? -1e150 : std::clamp(f, -1e150, 1e150);
 }
 
+/// Where a space-time blend's operand is evaluated for the world point w: w moved by its
+/// warp's backward displacement (SpaceTimeWarp.h), or w itself without a warp.
+Vec3 warped(const SpaceTimeWarp& warp, const std::vector<Vec3>& shifts, const Vec3& w)
+{
+  if (warp.empty())
+    return w;
+  const Vec3 d = warp.shift(shifts, w);
+  return { w[0] + d[0], w[1] + d[1], w[2] + d[2] };
+}
+
+/// The boxes an operand is evaluated on for the world box w: the displacement is a convex
+/// combination of the nodes' shifts, so it lies in their bounding box.
+Box3 warpedBox(const std::vector<Vec3>& shifts, Box3 w)
+{
+  if (shifts.empty())
+    return w;
+  for (int k = 0; k < 3; ++k)
+  {
+    double lo = Inf, hi = -Inf;
+    for (const Vec3& d : shifts)
+    {
+      lo = std::min(lo, d[k]);
+      hi = std::max(hi, d[k]);
+    }
+    w.lo[k] += lo;
+    w.hi[k] += hi;
+  }
+  return w;
+}
+
+/// An operand's value at the warped point and its gradient with respect to w (the chain rule:
+/// the transposed Jacobian of w -> w + shift(w) times the operand's gradient there).
+double warpedGradient(const Prepared& operand, const SpaceTimeWarp& warp,
+  const std::vector<Vec3>& shifts, const Vec3& w, Vec3& g)
+{
+  if (warp.empty())
+    return operand.gradient(w, g);
+  double j[9];
+  const Vec3 d = warp.shift(shifts, w, j);
+  Vec3 go;
+  const double v = operand.gradient({ w[0] + d[0], w[1] + d[1], w[2] + d[2] }, go);
+  for (int c = 0; c < 3; ++c)
+    g[c] = go[c] + j[c] * go[0] + j[3 + c] * go[1] + j[6 + c] * go[2];
+  return v;
+}
+
 /// The cross-section's value g(fa, fb) and its partial derivatives (dg/dfa, dg/dfb, 0).
 double spaceTimeSlice(const PreparedPart& pp, double fa, double fb, Vec3& dg)
 {
@@ -268,7 +314,8 @@ double Prepared::partValue(const PreparedPart& pp, Vec3 w) const
   if (p.kind == ShapePart::Kind::SpaceTimeBlend)
   {
     Vec3 unused;
-    return spaceTimeSlice(pp, pp.a->value(w), pp.b->value(w), unused);
+    return spaceTimeSlice(pp, pp.a->value(warped(p.warp, p.warp.shiftA, w)),
+      pp.b->value(warped(p.warp, p.warp.shiftB, w)), unused);
   }
   Vec3 l = pp.toLocal.apply(w);
   if (pp.dim <= 2)
@@ -336,7 +383,8 @@ Interval Prepared::partBound(const PreparedPart& pp, const Box3& w) const
   }
   if (p.kind == ShapePart::Kind::SpaceTimeBlend)
   {
-    const Interval fa = pp.a->bound(w), fb = pp.b->bound(w);
+    const Interval fa = pp.a->bound(warpedBox(p.warp.shiftA, w)),
+                   fb = pp.b->bound(warpedBox(p.warp.shiftB, w));
     const Interval g = pp.eval->bound({ { operandValue(fa.lo), operandValue(fb.lo), 0 },
       { operandValue(fa.hi), operandValue(fb.hi), 0 } });
     return g.empty() || g.maybeNaN ? iv(-Inf, Inf) : g;
@@ -443,7 +491,8 @@ double Prepared::partGradient(const PreparedPart& pp, Vec3 w, Vec3& g) const
   if (p.kind == ShapePart::Kind::SpaceTimeBlend)
   {
     Vec3 ga, gb, dg;
-    const double fa = pp.a->gradient(w, ga), fb = pp.b->gradient(w, gb);
+    const double fa = warpedGradient(*pp.a, p.warp, p.warp.shiftA, w, ga);
+    const double fb = warpedGradient(*pp.b, p.warp, p.warp.shiftB, w, gb);
     const double v = spaceTimeSlice(pp, fa, fb, dg);
     for (int i = 0; i < 3; ++i)
     {

@@ -171,9 +171,9 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
     { Id::Union, { "union", 2, 2, "union(cellA, cellB)", "shape" }, 2,
       "the union of two cells' shapes" },
     { Id::SpaceTimeBlend,
-      { "spaceTimeBlendCells", 8, 9,
+      { "spaceTimeBlendCells", 8, -1,
         "spaceTimeBlendCells(cellA, cellB, real t0, real t1, real a0, real a1, real a2, real a3, "
-        "real align)",
+        "real align, vec3 source, vec3 destination, ...)",
         "shape" },
       2,
       "the space-time blend (thesis 5.3.1) of two cells' shapes of dimension k, a T-cell of "
@@ -182,7 +182,12 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
       "(the operands') and a3 (the time slab's); no defaults: they depend on the shapes' "
       "sizes and the interval's length. `align` (optional, 0 to 1; thesis 5.3.2) moves each "
       "operand's extrusion toward the other's bounding domain during the transition, so that "
-      "at 1 they meet halfway" },
+      "at 1 they meet halfway. The warp (optional, after align = 0; thesis 5.3.3) deforms the "
+      "operands so that features travel along t: 2 or more pairs `source, destination` (a "
+      "feature of cellA at source becomes one of cellB at destination), or in their place "
+      "`int n, real separation`: n automatic control points of each operand (eq. 4: maxima of "
+      "its distance transform, at least separation apart; n from 1 to 8), paired by least total "
+      "distance" },
     { Id::LoadMesh, { "loadMesh", 2, 2, "loadMesh(string path, string animation)", "shape" }, 0,
       "a skinned, animated mesh (.x, .gltf, .fbx... read with Assimp; relative to the model's "
       "folder) played by the named animation at the cell's time: a B-cell surface, `dim = 2D`, "
