@@ -331,8 +331,10 @@ TEST(IcmModels, Andyhausen)
   EXPECT_EQ(m.instances[2].name.text, "EGG_ERODING");
   EXPECT_EQ(m.instances[3].name.text, "ANDY_OUT");
   const auto& deps = m.instances[0].relations[0].dependency;
-  ASSERT_EQ(deps.size(), 5u);
+  ASSERT_EQ(deps.size(), 7u); // the chain's five, and the yolk and the white on the contents
   EXPECT_DOUBLE_EQ(deps[1].priority, 0.5);
+  EXPECT_TRUE(deps[5].hierarchical);
+  EXPECT_TRUE(deps[6].hierarchical);
   // EGG_GOING_DOWN uses the template's cells without the melting egg.
   const auto& use = m.instances[1].cells[0].uses[0];
   ASSERT_EQ(use.minus.size(), 1u);
