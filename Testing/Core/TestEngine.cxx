@@ -774,7 +774,7 @@ TEST(EngineInstances, CellsDeriveFromTheTemplate)
   for (const auto& c : m.cells())
     names.push_back(c.name);
   const std::vector<std::string> expected = { "Handle1", "Handle2", "Barrel", "Rope", "Hook",
-    "Egg_contents", "Liquid", "Eggshell" };
+    "Egg_contents", "Egg_yolk", "Egg_white", "Liquid", "Eggshell" };
   EXPECT_EQ(names, expected);
 
   DynamicModel d = fromText("CELLS { A { shape = disk(1); dim = 2D; }\n"

@@ -660,8 +660,9 @@ TEST(IcmDiagnostics, LineColumnAndMessage)
       "3:90: error: instance 'K' has more than one predicate" },
     { "cell type", "CELLS { A { type = X-CELL; } }",
       "1:20: error: type = P-CELL, F-CELL, C-CELL, B-CELL or T-CELL" },
-    { "shape file", "CELLS { A { shape = file(\"a.stl\"); } }",
-      "1:26: error: file \"a.stl\": the shape files are .hf, .xml, .obj or .off" },
+    { "shape file", "CELLS { A { shape = file(\"a.vtp\"); } }",
+      "1:26: error: file \"a.vtp\": the shape files are .hf, .xml, .obj, .off, .ply or .stl (save "
+      "a .vtp surface as .ply or .stl, e.g. with ParaView)" },
     { "shape builtin", "CELLS { A { shape = torus(1, 2); } }",
       "1:21: error: unknown shape constructor 'torus'" },
     { "domain", "CELLS { A { domain = { 1, 0, 0, 1 }; } }",
