@@ -252,25 +252,123 @@ TEST(EngineExemplars, AndyhausenChainOrderAndInstances)
 // 2 units up in the last 10 s, is at y = 0.5 + 2 x 9.653125 / 10 = 2.430625 in the hook's frame.
 TEST(EngineExemplars, AndyhausenRunsItsWholeFilm)
 {
-  DynamicModel m = load("andyhausen.icm");
-  EXPECT_EQ(m.timeRange(), std::make_pair(0.0, 20.0));
-  std::vector<std::string> instances;
-  std::size_t frames = 0;
-  for (int k = 0; k <= 100; ++k)
+  // At the README's step (`ictk run` without --frames: the film in 100 steps, 0.2) and at 0.05.
+  for (const int steps : { 100, 400 })
   {
-    for (const FrameRecord& r : m.advanceTo(0.2 * k, 0.2))
+    SCOPED_TRACE(std::to_string(steps) + " steps");
+    const double dt = 20.0 / steps;
+    DynamicModel m = load("andyhausen.icm");
+    EXPECT_EQ(m.timeRange(), std::make_pair(0.0, 20.0));
+    std::vector<std::string> instances;
+    std::vector<double> transitions;
+    std::size_t frames = 0;
+    for (int k = 0; k <= steps; ++k)
     {
-      if (instances.empty() || instances.back() != r.instance)
-        instances.push_back(r.instance);
-      frames += r.transition ? 0 : 1;
+      for (const FrameRecord& r : m.advanceTo(dt * k, dt))
+      {
+        if (instances.empty() || instances.back() != r.instance)
+          instances.push_back(r.instance);
+        if (r.transition && r.time > 0)
+          transitions.push_back(r.time);
+        frames += r.transition ? 0 : 1;
+      }
     }
+    EXPECT_EQ(m.time(), 20.0);
+    EXPECT_EQ(frames, static_cast<std::size_t>(steps)); // t = 0 is the start record, a transition
+    EXPECT_EQ(instances, (std::vector<std::string>{ "EGG_GOING_DOWN", "EGG_ERODING", "ANDY_OUT" }));
+    ASSERT_EQ(transitions.size(), 2u);
+    EXPECT_NEAR(transitions[0], 3.0, 1e-6);
+    EXPECT_NEAR(transitions[1], 6.346875, 1e-5);
+    EXPECT_EQ(m.activeInstance(), "ANDY_OUT");
+    EXPECT_NEAR(real(m, "Skeleton.translation.y"), 2.430625, 1e-4);
+    EXPECT_NEAR(real(m, "Skeleton.height"), 2.430625, 1e-4);
   }
-  EXPECT_EQ(m.time(), 20.0);
-  EXPECT_EQ(frames, 100u); // t = 0.2 .. 20 (t = 0 is the start record, a transition)
-  EXPECT_EQ(instances, (std::vector<std::string>{ "EGG_GOING_DOWN", "EGG_ERODING", "ANDY_OUT" }));
-  EXPECT_EQ(m.activeInstance(), "ANDY_OUT");
-  EXPECT_NEAR(real(m, "Skeleton.translation.y"), 2.430625, 1e-4);
-  EXPECT_NEAR(real(m, "Skeleton.height"), 2.430625, 1e-4);
+}
+
+namespace
+{
+
+std::optional<ictk::engine::CellState> cellNamed(const DynamicModel& m, const std::string& name)
+{
+  for (const ictk::engine::CellState& c : m.cells())
+    if (c.name == name)
+      return c;
+  return std::nullopt;
+}
+
+/// The centroid of {value >= 0} of a 3D shape, from the centres of an n^3 grid over its world box.
+ictk::geometry::Vec3 sampledCentroid(const ictk::geometry::PlacedShape& shape, int n)
+{
+  const ictk::frep::Box3 b = shape.worldBounds();
+  ictk::geometry::Vec3 sum{ 0, 0, 0 };
+  double count = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k)
+      {
+        const ictk::geometry::Vec3 p{ b.lo[0] + (i + 0.5) * (b.hi[0] - b.lo[0]) / n,
+          b.lo[1] + (j + 0.5) * (b.hi[1] - b.lo[1]) / n,
+          b.lo[2] + (k + 0.5) * (b.hi[2] - b.lo[2]) / n };
+        if (shape.value(p) >= 0)
+        {
+          for (int d = 0; d < 3; ++d)
+            sum[d] += p[d];
+          count += 1;
+        }
+      }
+  EXPECT_GT(count, 0) << shape.cell;
+  return { sum[0] / count, sum[1] / count, sum[2] / count };
+}
+
+} // namespace
+
+// Issue 16: the egg contents stay in the egg when their parent changes. EGG_ERODING carries
+// Egg_contents by Eggshell (HIERARCHICAL); ANDY_OUT, from t = 6.346875, drops that relation and
+// the shell. The contents then kept only their own transform, the identity, and jumped to the
+// origin. A cell whose hierarchical parent changes now keeps its place in the world: the
+// contents stay where the shell left them, centred 0.7 below the hook of the switch,
+// y = -0.6 - 0.4 x 6.346875 - 0.7 = -3.83875.
+TEST(EngineExemplars, AndyhausenEggContentsStayInTheEgg)
+{
+  DynamicModel m = load("andyhausen.icm");
+  m.advanceTo(6.0, 0.25);
+  std::optional<ictk::frep::Box3> egg;
+  std::string lastInstance;
+  int framesOut = 0;
+  for (int k = 1; k <= 20; ++k) // 6.05 .. 7.0
+  {
+    const double t = 6.0 + 0.05 * k;
+    m.advanceTo(t, 0.05);
+    if (const auto shell = cellNamed(m, "Eggshell"))
+    {
+      egg = shell->shape->worldBounds();
+      // The shell's centre is 0.7 below the hook (hook at y = -0.6 - 0.4 t).
+      EXPECT_NEAR(0.5 * (egg->lo[1] + egg->hi[1]), -1.3 - 0.4 * t, 1e-9) << "t = " << t;
+    }
+    ASSERT_TRUE(egg.has_value());
+    const auto contents = cellNamed(m, "Egg_contents");
+    ASSERT_TRUE(contents.has_value()) << "t = " << t;
+    const ictk::geometry::Vec3 c = sampledCentroid(*contents->shape, 24);
+    for (int d = 0; d < 3; ++d)
+    {
+      EXPECT_GE(c[d], egg->lo[d]) << "t = " << t << " axis " << d;
+      EXPECT_LE(c[d], egg->hi[d]) << "t = " << t << " axis " << d;
+    }
+    // The contents are symmetric about their centre: the sampled centroid is the centre to a
+    // fraction of a grid cell (1.2 / 24 = 0.05 along y).
+    const double centre = t < 6.346875 ? -1.3 - 0.4 * t : -3.83875;
+    EXPECT_NEAR(c[1], centre, 0.01) << "t = " << t;
+    EXPECT_NEAR(c[0], 0.0, 0.01) << "t = " << t;
+    EXPECT_NEAR(c[2], 0.0, 0.01) << "t = " << t;
+    if (m.activeInstance() == "ANDY_OUT")
+    {
+      ++framesOut;
+      EXPECT_NEAR(contents->shape->place.apply({ 0, 0, 0 })[1], -3.83875, 1e-5) << "t = " << t;
+    }
+    lastInstance = m.activeInstance();
+  }
+  EXPECT_EQ(lastInstance, "ANDY_OUT");
+  EXPECT_EQ(framesOut, 14); // 6.35 .. 7.0
 }
 
 TEST(EngineExemplars, AndyhausenRopeFollowsTheBarrel)
@@ -326,6 +424,45 @@ TEST(EngineExemplars, AndyhausenMeltingEggFollowsItsBlendRate)
   EXPECT_LT(amounts.front(), 0.05);
   EXPECT_DOUBLE_EQ(amounts.back(), 0.5);
   EXPECT_TRUE(std::is_sorted(amounts.begin(), amounts.end()));
+}
+
+// Thesis L3627-L3633: the liquid's noise changes its phase with time. Its field is
+// (-3.2 - y + 0.02 sin(2t) sin(8x) sin(8z)) & (4 - x^2 - z^2) with the phase 2t set by its update
+// (setShapeParameter), so at a point the field moves between two times as the formula says, and at
+// t = k pi / 2 (phase k pi) the surface is flat again: a point on the level y = -3.2 is on it.
+TEST(EngineExemplars, AndyhausenLiquidNoisePhaseFollowsTime)
+{
+  DynamicModel m = load("andyhausen.icm");
+  const ictk::geometry::Vec3 p{ 0.3, -3.2, -0.15 }, q{ 1.1, -3.25, 0.7 };
+  auto formula = [](const ictk::geometry::Vec3& x, double t)
+  {
+    // HyperFun's & is the R-function intersection f + g - sqrt(f^2 + g^2).
+    const double f = -3.2 - x[1] + 0.02 * std::sin(2 * t) * std::sin(8 * x[0]) * std::sin(8 * x[2]);
+    const double g = 4 - x[0] * x[0] - x[2] * x[2];
+    return f + g - std::sqrt(f * f + g * g);
+  };
+  std::vector<double> values;
+  for (const double t : { 0.5, 1.25, pi / 2, 4.0, 9.0 })
+  {
+    m.advanceTo(t, 0.25);
+    EXPECT_NEAR(real(m, "Liquid.noisePhase"), 2 * t, 1e-12);
+    bool found = false;
+    for (const ictk::engine::CellState& c : m.cells())
+    {
+      if (c.name != "Liquid")
+        continue;
+      found = true;
+      EXPECT_NEAR(c.shape->value(p), formula(p, t), 1e-9) << "t = " << t;
+      EXPECT_NEAR(c.shape->value(q), formula(q, t), 1e-9) << "t = " << t;
+      values.push_back(c.shape->value(p));
+    }
+    ASSERT_TRUE(found) << "t = " << t;
+  }
+  // p is on the rest level: there the ripple 0.02 sin(2t) sin(2.4) sin(-1.2) (-0.0106 at t = 0.5,
+  // -0.0075 at 1.25, 0 at pi / 2) is the first operand.
+  EXPECT_LT(values[0], -0.01);
+  EXPECT_GT(values[1], values[0] + 0.0025);
+  EXPECT_NEAR(values[2], 0.0, 1e-9);
 }
 
 TEST(EngineExemplars, Deterministic)
@@ -665,7 +802,7 @@ TEST(EngineInstances, CellsDeriveFromTheTemplate)
   for (const auto& c : m.cells())
     names.push_back(c.name);
   const std::vector<std::string> expected = { "Handle1", "Handle2", "Barrel", "Rope", "Hook",
-    "Egg_contents", "Liquid", "Eggshell" };
+    "Egg_contents", "Egg_yolk", "Egg_white", "Liquid", "Eggshell" };
   EXPECT_EQ(names, expected);
 
   DynamicModel d = fromText("CELLS { A { shape = disk(1); dim = 2D; }\n"

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Mesh files as B-cells (issue 16): `shape = file("cube.off")` / `file("tetra.obj")` are read by
+// Mesh files as B-cells (issue 16): `shape = file("cube.off")` / `file("tetra.obj")` (and .ply,
+// .stl) are read by
 // Lang/MeshFile.h (faces triangulated as fans) and become explicit 2D cells of the complex, their
 // points moved by the cell's placement every frame. A unit cube scaled by 2 and translated by
 // (1, 2, 3) has 8 points at (1 +- 1, 2 +- 1, 3 +- 1), 12 triangles and an area of 6 x 2^2 = 24.
@@ -13,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -95,6 +98,200 @@ TEST(MeshFiles, ReadsObjAndOffTriangulated)
     EXPECT_EQ(e.diagnostics().at(0).where.line, 3);
     EXPECT_NE(std::string(e.what()).find("z is not a finite number: 'zero'"), std::string::npos)
       << e.what();
+  }
+}
+
+namespace
+{
+
+// The unit cube of cube.off as 12 outward triangles (each quad a, b, c, d as a b c, a c d).
+const double kCorners[8][3] = { { -0.5, -0.5, -0.5 }, { 0.5, -0.5, -0.5 }, { 0.5, 0.5, -0.5 },
+  { -0.5, 0.5, -0.5 }, { -0.5, -0.5, 0.5 }, { 0.5, -0.5, 0.5 }, { 0.5, 0.5, 0.5 },
+  { -0.5, 0.5, 0.5 } };
+const int kQuads[6][4] = { { 0, 3, 2, 1 }, { 4, 5, 6, 7 }, { 0, 1, 5, 4 }, { 2, 3, 7, 6 },
+  { 1, 2, 6, 5 }, { 0, 4, 7, 3 } };
+
+std::vector<std::array<int, 3>> cubeTriangles()
+{
+  std::vector<std::array<int, 3>> t;
+  for (const auto& q : kQuads)
+  {
+    t.push_back({ q[0], q[1], q[2] });
+    t.push_back({ q[0], q[2], q[3] });
+  }
+  return t;
+}
+
+template <typename T>
+void put(std::ostream& out, T v, bool bigEndian)
+{
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  if (bigEndian) // the test machines are little-endian (x86-64, arm64)
+    std::reverse(b, b + sizeof(T));
+  out.write(reinterpret_cast<const char*>(b), sizeof(T));
+}
+
+/// The cube as ASCII and binary .ply (with a normal per vertex, a colour per face, and an edge
+/// element the reader must skip) and ASCII and binary .stl.
+void writeCubes(const fs::path& dir)
+{
+  const auto tris = cubeTriangles();
+  {
+    std::ofstream out(dir / "cube_ascii.ply");
+    out << "ply\nformat ascii 1.0\ncomment a unit cube\nelement vertex 8\nproperty float x\n"
+           "property float y\nproperty float z\nproperty float nx\nelement face 6\n"
+           "property list uchar int vertex_indices\nproperty uchar red\nend_header\n";
+    for (const auto& c : kCorners)
+      out << c[0] << " " << c[1] << " " << c[2] << " 0\n";
+    for (const auto& q : kQuads)
+      out << "4 " << q[0] << " " << q[1] << " " << q[2] << " " << q[3] << " 255\n";
+  }
+  for (const bool big : { false, true })
+  {
+    std::ofstream out(dir / (big ? "cube_big.ply" : "cube_little.ply"), std::ios::binary);
+    out << "ply\nformat " << (big ? "binary_big_endian" : "binary_little_endian")
+        << " 1.0\nelement vertex 8\nproperty double x\nproperty double y\nproperty float z\n"
+           "property uchar flag\nelement face 12\nproperty list uchar uint vertex_indices\n"
+           "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n";
+    for (const auto& c : kCorners)
+    {
+      put(out, c[0], big);
+      put(out, c[1], big);
+      put(out, static_cast<float>(c[2]), big);
+      put(out, std::uint8_t{ 7 }, big);
+    }
+    for (const auto& t : tris)
+    {
+      put(out, std::uint8_t{ 3 }, big);
+      for (int k : t)
+        put(out, static_cast<std::uint32_t>(k), big);
+    }
+    put(out, std::int32_t{ 0 }, big);
+    put(out, std::int32_t{ 1 }, big);
+  }
+  {
+    std::ofstream out(dir / "cube_ascii.stl");
+    out << "solid cube\n";
+    for (const auto& t : tris)
+    {
+      out << "  facet normal 0 0 0\n    outer loop\n";
+      for (int k : t)
+        out << "      vertex " << kCorners[k][0] << " " << kCorners[k][1] << " " << kCorners[k][2]
+            << "\n";
+      out << "    endloop\n  endfacet\n";
+    }
+    out << "endsolid cube\n";
+  }
+  {
+    // A binary .stl whose header starts with "solid", as many exporters write.
+    std::ofstream out(dir / "cube_binary.stl", std::ios::binary);
+    std::string header = "solid cube, binary";
+    header.resize(80, ' ');
+    out << header;
+    put(out, static_cast<std::uint32_t>(tris.size()), false);
+    for (const auto& t : tris)
+    {
+      for (int k = 0; k < 3; ++k)
+        put(out, 0.0f, false);
+      for (int k : t)
+        for (int a = 0; a < 3; ++a)
+          put(out, static_cast<float>(kCorners[k][a]), false);
+      put(out, std::uint16_t{ 0 }, false);
+    }
+  }
+}
+
+/// Area and enclosed volume (divergence theorem: the sum of p0 . (p1 x p2) / 6) of a surface.
+std::pair<double, double> areaAndVolume(const ictk::complex::ExplicitGeometry& g)
+{
+  double area = 0, volume = 0;
+  for (const auto& t : g.triangles)
+  {
+    const auto &a = g.points[t[0]], &b = g.points[t[1]], &c = g.points[t[2]];
+    const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+    const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+    const double n[3] = { u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+      u[0] * v[1] - u[1] * v[0] };
+    area += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+                a[2] * (b[0] * c[1] - b[1] * c[0])) /
+      6.0;
+  }
+  return { area, volume };
+}
+
+} // namespace
+
+// Issue 16: .ply (ASCII, binary little- and big-endian) and .stl (ASCII, binary) read as the
+// unit cube: 8 points (the .stl's 36 corners welded), 12 triangles, area 6, volume 1.
+TEST(MeshFiles, ReadsPlyAndStl)
+{
+  const fs::path dir = Folder();
+  writeCubes(dir);
+  for (const char* name :
+    { "cube_ascii.ply", "cube_little.ply", "cube_big.ply", "cube_ascii.stl", "cube_binary.stl" })
+  {
+    SCOPED_TRACE(name);
+    const ictk::complex::ExplicitGeometry g = ictk::lang::readMeshFile((dir / name).string());
+    EXPECT_EQ(g.points.size(), 8u);
+    EXPECT_EQ(g.triangles.size(), 12u);
+    const auto [area, volume] = areaAndVolume(g);
+    EXPECT_NEAR(area, 6.0, 1e-12);
+    EXPECT_NEAR(volume, 1.0, 1e-12);
+  }
+  // Bad files name what is wrong.
+  std::ofstream(dir / "bad.ply") << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                                    "property float y\nend_header\n0 0\n";
+  std::ofstream(dir / "bad.stl") << "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                                    "vertex 1 0 0\nendloop\nendfacet\nendsolid\n";
+  std::ofstream(dir / "bad_index.ply") << "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                          "property float x\nproperty float y\nproperty float z\n"
+                                          "element face 1\nproperty list uchar int vertex_indices\n"
+                                          "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n";
+  const std::pair<const char*, const char*> bad[] = { { "bad.ply", "no x, y and z properties" },
+    { "bad.stl", "fewer than 3" }, { "bad_index.ply", "a face uses vertex 6 of 3" } };
+  for (const auto& [name, message] : bad)
+  {
+    try
+    {
+      ictk::lang::readMeshFile((dir / name).string());
+      ADD_FAILURE() << name << " was read";
+    }
+    catch (const ictk::lang::ParseError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Each format as the shape of a running model's B-cell, scaled by 2: area 24 in every frame.
+TEST(MeshFiles, PlyAndStlCellsRunInFrames)
+{
+  const fs::path dir = Folder();
+  writeCubes(dir);
+  std::string cells, names;
+  const char* files[] = { "cube_ascii.ply", "cube_big.ply", "cube_binary.stl", "cube_ascii.stl" };
+  for (int i = 0; i < 4; ++i)
+  {
+    cells += "  C" + std::to_string(i) + " { type = B-CELL; shape = file(\"" + files[i] +
+      "\"); dim = 2D; parameters { scale(2, 2, 2); } }\n";
+    names += " C" + std::to_string(i);
+  }
+  const fs::path path = dir / "formats.icm";
+  std::ofstream(path) << "TIMESPANS { film : TIMESPAN(0, 1); }\nCELLS {\n"
+                      << cells << "}\nK { CELLS {" << names << "; } }\n";
+  engine::FrameSequenceOptions options;
+  options.times = { 0.0, 1.0 };
+  options.discretization.featureSize = 0.1;
+  engine::FrameSequence frames(path.string(), options);
+  for (std::size_t f = 0; f < 2; ++f)
+  {
+    const engine::Frame frame = frames.frame(f);
+    ASSERT_EQ(frame.mesh.cells.size(), 4u);
+    for (std::size_t i = 0; i < 4; ++i)
+      EXPECT_NEAR(ictk::discretize::surfaceArea(frame.mesh.cells[i].surface), 24.0, 1e-9)
+        << files[i];
   }
 }
 
@@ -183,8 +380,9 @@ TEST(MeshFiles, CheckerAndEngineRefuseWhatTheyCannotDo)
       "  C { type = T-CELL; shape = blend(B, A, 0.5); dim = 3D; }\n}\nK { CELLS { A B C; } }\n");
   EXPECT_EQ(e.substr(0, e.find(' ')), "4:39") << e;
   EXPECT_NE(e.find("is a mesh"), std::string::npos) << e;
-  e = error("stl.icm", "CELLS {\n  A { type = B-CELL; shape = file(\"a.stl\"); dim = 2D; }\n}\n");
+  e = error("vtp.icm", "CELLS {\n  A { type = B-CELL; shape = file(\"a.vtp\"); dim = 2D; }\n}\n");
   EXPECT_EQ(e.substr(0, e.find(' ')), "2:35") << e;
+  EXPECT_NE(e.find("save a .vtp surface as .ply or .stl"), std::string::npos) << e;
   e = error("dim.icm",
     "CELLS {\n  A { type = B-CELL;\n    shape = file(\"cube.off\");\n    dim = 3D; }\n}\nK { CELLS "
     "{ A; } }\n");

@@ -331,8 +331,10 @@ TEST(IcmModels, Andyhausen)
   EXPECT_EQ(m.instances[2].name.text, "EGG_ERODING");
   EXPECT_EQ(m.instances[3].name.text, "ANDY_OUT");
   const auto& deps = m.instances[0].relations[0].dependency;
-  ASSERT_EQ(deps.size(), 5u);
+  ASSERT_EQ(deps.size(), 7u); // the chain's five, and the yolk and the white on the contents
   EXPECT_DOUBLE_EQ(deps[1].priority, 0.5);
+  EXPECT_TRUE(deps[5].hierarchical);
+  EXPECT_TRUE(deps[6].hierarchical);
   // EGG_GOING_DOWN uses the template's cells without the melting egg.
   const auto& use = m.instances[1].cells[0].uses[0];
   ASSERT_EQ(use.minus.size(), 1u);
@@ -658,8 +660,9 @@ TEST(IcmDiagnostics, LineColumnAndMessage)
       "3:90: error: instance 'K' has more than one predicate" },
     { "cell type", "CELLS { A { type = X-CELL; } }",
       "1:20: error: type = P-CELL, F-CELL, C-CELL, B-CELL or T-CELL" },
-    { "shape file", "CELLS { A { shape = file(\"a.stl\"); } }",
-      "1:26: error: file \"a.stl\": the shape files are .hf, .xml, .obj or .off" },
+    { "shape file", "CELLS { A { shape = file(\"a.vtp\"); } }",
+      "1:26: error: file \"a.vtp\": the shape files are .hf, .xml, .obj, .off, .ply or .stl (save "
+      "a .vtp surface as .ply or .stl, e.g. with ParaView)" },
     { "shape builtin", "CELLS { A { shape = torus(1, 2); } }",
       "1:21: error: unknown shape constructor 'torus'" },
     { "domain", "CELLS { A { domain = { 1, 0, 0, 1 }; } }",

@@ -154,6 +154,7 @@ std::vector<std::size_t> ModelState::validInstances(double t)
 
 void ModelState::setActive(std::size_t i, double t)
 {
+  keepPlacementsAcross(s.active, i);
   s.previous = s.active;
   const auto* before = s.active != kNone ? &instances[s.active].cells : nullptr;
   for (const std::string& cell : instances[i].cells)

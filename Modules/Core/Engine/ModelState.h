@@ -205,6 +205,9 @@ struct Structure
   std::map<std::string, std::shared_ptr<const std::vector<Affine>>> deformations;
   /// setProjection(cell, alpha): how far a skinned mesh's vertices have moved to its stand-in.
   std::map<std::string, double> projections;
+  /// Cells whose hierarchical parent changed at an instance switch: the offset that keeps their
+  /// placement in the world at the switch (ModelState::keepPlacementsAcross).
+  std::map<std::string, Affine> keptPlacements;
 };
 
 struct ModelState
@@ -348,6 +351,14 @@ struct ModelState
   }
   Affine localPlace(const std::string& cell) const;
   Affine place(const std::string& cell, int depth = 0) const;
+  /// The hierarchical parent of `cell` in `instance` (its first HIERARCHICAL master), or "".
+  std::string hierarchicalParent(const std::string& cell, std::size_t instance) const;
+  /// What carries the cell's own transform into the world: its parent's placement, times the
+  /// offset kept when its parent changed (Structure::keptPlacements).
+  Affine carrier(const std::string& cell, int depth = 0) const;
+  /// At a switch from instance `from` to `to`: every cell in both whose hierarchical parent
+  /// changes keeps its placement in the world (Structure::keptPlacements).
+  void keepPlacementsAcross(std::size_t from, std::size_t to);
   PlacedShapePtr shapeOf(const std::string& cell, int depth = 0) const;
   /// spaceTimeBlendCells' automatic alignment (OperandNumbers::align) of the operands at time t.
   void alignInSpaceTime(

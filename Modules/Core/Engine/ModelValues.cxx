@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 
 namespace ictk::engine
 {
@@ -240,18 +241,75 @@ Affine ModelState::localPlace(const std::string& cell) const
   return Affine::fromTransform(v("translation"), v("rotation"), v("scale"));
 }
 
-Affine ModelState::place(const std::string& cell, int depth) const
+std::string ModelState::hierarchicalParent(const std::string& cell, std::size_t instance) const
+{
+  if (instance == kNone)
+    return {};
+  // The first hierarchical parent in the instance carries the cell.
+  for (const RelationSpec& r : instances[instance].dependency)
+    if (r.hierarchical && r.dependent == cell && cellIndex.count(r.master))
+      return r.master;
+  return {};
+}
+
+Affine ModelState::carrier(const std::string& cell, int depth) const
 {
   if (depth > static_cast<int>(cells.size()))
     throw std::runtime_error("HIERARCHICAL dependencies form a cycle through " + cell);
-  Affine local = localPlace(cell);
-  if (s.active == kNone)
-    return local;
-  // The first hierarchical parent in the active instance carries the cell.
-  for (const RelationSpec& r : instances[s.active].dependency)
-    if (r.hierarchical && r.dependent == cell && cellIndex.count(r.master))
-      return place(r.master, depth + 1) * local;
-  return local;
+  const std::string parent = hierarchicalParent(cell, s.active);
+  const Affine byParent = parent.empty() ? Affine{} : place(parent, depth + 1);
+  const auto kept = s.keptPlacements.find(cell);
+  return kept == s.keptPlacements.end() ? byParent : byParent * kept->second;
+}
+
+Affine ModelState::place(const std::string& cell, int depth) const
+{
+  return carrier(cell, depth) * localPlace(cell);
+}
+
+void ModelState::keepPlacementsAcross(std::size_t from, std::size_t to)
+{
+  if (from == kNone)
+    return;
+  // A cell that stays while its hierarchical parent changes (thesis App. C: ANDY_OUT drops
+  // Eggshell -> Egg_contents) keeps where it is in the world, as a scene graph re-parents a node:
+  // its carrier before the switch becomes its new parent's placement times a kept offset, so
+  // only later motion of the new parent (or of its own transform) moves it.
+  const auto& before = instances[from].cells;
+  std::map<std::string, Affine> carried;
+  for (const std::string& cell : instances[to].cells)
+  {
+    if (std::find(before.begin(), before.end(), cell) == before.end())
+      s.keptPlacements.erase(cell); // a cell that enters is placed afresh
+    else if (hierarchicalParent(cell, from) != hierarchicalParent(cell, to))
+      carried[cell] = carrier(cell);
+  }
+  const std::size_t saved = s.active;
+  s.active = to;
+  std::set<std::string> done;
+  // Parents first: a re-parented parent's kept offset is part of its child's new carrier.
+  std::function<void(const std::string&, int)> keep = [&](const std::string& cell, int depth)
+  {
+    if (done.count(cell) || depth > static_cast<int>(cells.size()))
+      return;
+    done.insert(cell);
+    const std::string parent = hierarchicalParent(cell, to);
+    if (!parent.empty() && carried.count(parent))
+      keep(parent, depth + 1);
+    s.keptPlacements.erase(cell);
+    const Affine byParent = parent.empty() ? Affine{} : place(parent);
+    try
+    {
+      s.keptPlacements[cell] = byParent.inverse() * carried.at(cell);
+    }
+    catch (const std::invalid_argument&)
+    {
+      // A parent scaled to nothing has no frame to keep the cell in: it follows the parent.
+    }
+  };
+  for (const auto& entry : carried)
+    keep(entry.first, 0);
+  s.active = saved;
 }
 
 namespace

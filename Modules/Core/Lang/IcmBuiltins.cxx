@@ -147,7 +147,8 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
   static const std::vector<ShapeBuiltin> table = {
     { Id::File, { "file", 1, 1, "file(string path)", "shape" }, 0,
       "relative to the model's folder: an FRep shape, `.hf` HyperFun or `.xml` FRep; or a "
-      "triangle mesh, `.obj` or `.off` (a B-cell surface, `dim = 2D`, placed by the cell; the "
+      "triangle mesh, `.obj`, `.off`, `.ply` or `.stl` (a B-cell surface, `dim = 2D`, placed by "
+      "the cell; the "
       "queries, `blend` and `union` do not take it)" },
     { Id::Point, { "point", 3, 3, "point(real x, real y, real z)", "shape" }, 0, "a point" },
     { Id::Segment, { "segment", 2, 2, "segment(vec3 p, vec3 q)", "shape" }, 0,

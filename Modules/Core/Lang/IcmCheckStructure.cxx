@@ -320,9 +320,14 @@ void Checker::shape(
     const std::string& path = a->text;
     const auto dot = path.rfind('.');
     const std::string ext = dot == std::string::npos ? std::string() : path.substr(dot);
-    if (ext != ".hf" && ext != ".xml" && ext != ".obj" && ext != ".off")
+    if (ext != ".hf" && ext != ".xml" && ext != ".obj" && ext != ".off" && ext != ".ply" &&
+      ext != ".stl")
     {
-      err(a->pos, "file \"" + path + "\": the shape files are .hf, .xml, .obj or .off");
+      // .vtp (VTK's XML polydata) is named: it is VTK's own format, which the VTK-free engine
+      // does not read.
+      err(a->pos,
+        "file \"" + path + "\": the shape files are .hf, .xml, .obj, .off, .ply or .stl" +
+          (ext == ".vtp" ? " (save a .vtp surface as .ply or .stl, e.g. with ParaView)" : ""));
     }
     return;
   }
