@@ -341,8 +341,7 @@ void ModelState::fitStandIns()
           "' is not one (shape = loadMesh(...))");
     try
     {
-      skin::StandIn standIn = skin::initialStandIn(*mesh.skinned);
-      skin::fitStandIn(standIn, mesh.skinned->restPoints);
+      skin::StandIn standIn = skin::fittedStandIn(*mesh.skinned);
       c.projection =
         std::make_shared<const skin::Projection>(skin::projectOntoStandIn(*mesh.skinned, standIn));
       c.standIn = std::make_shared<const skin::StandIn>(std::move(standIn));

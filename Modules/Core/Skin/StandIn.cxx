@@ -468,6 +468,17 @@ StandInFitReport fitEmbeddedStandIn(StandIn& standIn, const std::vector<Vec3>& p
   return report;
 }
 
+StandIn fittedStandIn(const SkinnedMesh& mesh, StandInFitReport* report)
+{
+  StandIn out = initialStandIn(mesh);
+  StandInFitOptions options;
+  options.margin = 0.05;
+  const StandInFitReport r = fitEmbeddedStandIn(out, mesh.restPoints, mesh.triangles, options);
+  if (report)
+    *report = r;
+  return out;
+}
+
 std::vector<Vec3> standInSurfaceSamples(const StandIn& standIn, int along, int directions)
 {
   frep::PointEvaluator f = fieldOf(standIn);

@@ -105,6 +105,10 @@ StandInFitReport fitStandIn(
 StandInFitReport fitEmbeddedStandIn(StandIn& standIn, const std::vector<Vec3>& points,
   const std::vector<std::array<int, 3>>& triangles, const StandInFitOptions& options = {});
 
+/// The stand-in of a mesh as models use it (the engine's standIn(cell)): the initial
+/// approximation fitted embedded in the rest mesh (fitEmbeddedStandIn) with a margin of 0.05.
+StandIn fittedStandIn(const SkinnedMesh& mesh, StandInFitReport* report = nullptr);
+
 // ---- how well the stand-in sits in its mesh (thesis L3276: "fully embed the convolution surface
 // into the mesh when no deformation is applied") --------------------------------------------------
 
