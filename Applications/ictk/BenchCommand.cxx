@@ -575,6 +575,7 @@ std::optional<Result> StandInFrame(int frames)
   const std::size_t n = mesh.vertexCount();
   std::vector<double> x(n), y(n), z(n), values(n);
   double insideShare = 0;
+  double poseSeconds = 0, compileSeconds = 0, evalSeconds = 0;
   r.allSeconds = Time(
     Options.Runs,
     [&]
@@ -583,11 +584,14 @@ std::optional<Result> StandInFrame(int frames)
       for (int k = 0; k < frames; ++k)
       {
         const double t = animation.durationSeconds() * k / frames;
+        const auto t0 = std::chrono::steady_clock::now();
         const std::vector<geometry::Affine> matrices =
           skin::jointMatrices(mesh, skin::poseNodes(mesh, &animation, t));
         const skin::Posed posed = skin::skin(mesh, matrices);
-        const frep::TapePtr tape = frep::Tape::compile(
-          skin::standInShape(skin::poseStandIn(standIn, matrices)).function());
+        const auto t1 = std::chrono::steady_clock::now();
+        const frep::TapePtr tape =
+          frep::Tape::compile(skin::standInShape(skin::poseStandIn(standIn, matrices)).function());
+        const auto t2 = std::chrono::steady_clock::now();
         for (std::size_t i = 0; i < n; ++i)
         {
           x[i] = posed.points[i][0];
@@ -602,10 +606,12 @@ std::optional<Result> StandInFrame(int frames)
               {
                 frep::BatchEvaluator<double> evaluator(tape);
                 evaluator.eval(x.data() + range.begin(), y.data() + range.begin(),
-                  z.data() + range.begin(), nullptr, values.data() + range.begin(),
-                  range.size());
+                  z.data() + range.begin(), nullptr, values.data() + range.begin(), range.size());
               });
           });
+        poseSeconds += std::chrono::duration<double>(t1 - t0).count();
+        compileSeconds += std::chrono::duration<double>(t2 - t1).count();
+        evalSeconds += Seconds(t2);
         inside += static_cast<std::size_t>(
           std::count_if(values.begin(), values.end(), [](double v) { return v >= 0; }));
       }
@@ -618,6 +624,11 @@ std::optional<Result> StandInFrame(int frames)
   r.details["vertices"] = n;
   r.details["segments"] = standIn.segments.size();
   r.details["ms_per_frame"] = 1000 * r.seconds / frames;
+  // Of all runs (the warm-up too): where a frame's time goes.
+  const double all = static_cast<double>(frames) * (Options.Runs + 1) / 1000;
+  r.details["ms_per_frame_skinning"] = poseSeconds / all;
+  r.details["ms_per_frame_stand_in_compiled"] = compileSeconds / all;
+  r.details["ms_per_frame_field_evaluated"] = evalSeconds / all;
   r.details["fit_seconds"] = fit.seconds;
   r.details["fit_newton_steps"] = fit.iterations;
   r.details["fit_mean_distance"] = { fit.initialMeanDistance, fit.finalMeanDistance };

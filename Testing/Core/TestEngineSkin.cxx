@@ -657,9 +657,8 @@ TEST(EngineStandInModel, TheCharacterWalksOutOfTheLiquidBox)
     const double x = std::max(d, 0.0) / 0.25;
     EXPECT_NEAR(m.value("Liquid_on_Andy.blendDensity").number, 0.5 / (1 + x * x), 1e-12)
       << "t " << t;
-    std::printf("t %.1f %s: %ld vertices in the box, distance %.4f, a0 %.4f\n", t,
-      instance.c_str(), static_cast<long>(inside), d,
-      m.value("Liquid_on_Andy.blendDensity").number);
+    std::printf("t %.1f %s: %ld vertices in the box, distance %.4f, a0 %.4f\n", t, instance.c_str(),
+      static_cast<long>(inside), d, m.value("Liquid_on_Andy.blendDensity").number);
   }
   EXPECT_EQ(transitions, 1);
   EXPECT_GT(switchTime, lastInside);

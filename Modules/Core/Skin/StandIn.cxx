@@ -118,13 +118,17 @@ StandIn initialStandIn(const SkinnedMesh& mesh)
 
 frep::Shape standInShape(const StandIn& standIn)
 {
-  SegmentFields fields(standIn);
+  // Each segment's normalisation from its own small tape (SegmentFields evaluates all of them at
+  // once: n times the work where one is wanted; this runs at every frame of a posed stand-in).
   frep::Expr sum;
   for (std::size_t i = 0; i < standIn.segments.size(); ++i)
   {
     const StandInSegment& g = standIn.segments[i];
-    const frep::Expr term =
-      frep::Expr(1 / fields.midField(g, i, g.radius)) * frep::cauchySegmentField(g.a, g.b, g.s);
+    const frep::Expr field = frep::cauchySegmentField(g.a, g.b, g.s);
+    frep::PointEvaluator own(frep::Tape::compile(field));
+    const Vec3 p =
+      frep::add(frep::lerp(g.a, g.b, 0.5), frep::scale(normalTo(sub(g.b, g.a)), g.radius));
+    const frep::Expr term = frep::Expr(1 / own.eval(p[0], p[1], p[2])) * field;
     sum = i == 0 ? term : sum + term;
   }
   return frep::Shape(sum - frep::Expr(1.0), frep::Domain::XYZ, "standIn");
