@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Discretize/Mesh.h"
+#include "Discretize/MeshRepair.h"
 
 #include "FRep/Vector.h"
 
@@ -37,6 +38,64 @@ struct UnionFind
 std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b)
 {
   return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+}
+
+/// The non-degenerate triangles using each vertex.
+std::vector<std::vector<std::uint32_t>> trianglesAroundVertices(const SurfaceMesh& mesh)
+{
+  std::vector<std::vector<std::uint32_t>> around(mesh.points.size());
+  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
+  {
+    const auto& tri = mesh.triangles[f];
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+    {
+      continue;
+    }
+    for (auto v : tri)
+    {
+      around[v].push_back(f);
+    }
+  }
+  return around;
+}
+
+/// The fans of vertex v: its triangles grouped by union-find, two linked when they share an
+/// edge (v, w). A manifold vertex has one fan; each group lists triangle indices.
+std::vector<std::vector<std::uint32_t>> fansAround(
+  const SurfaceMesh& mesh, std::uint32_t v, const std::vector<std::uint32_t>& triangles)
+{
+  std::map<std::uint32_t, std::vector<std::size_t>> byOther;
+  for (std::size_t i = 0; i < triangles.size(); ++i)
+  {
+    for (auto w : mesh.triangles[triangles[i]])
+    {
+      if (w != v)
+      {
+        byOther[w].push_back(i);
+      }
+    }
+  }
+  UnionFind local(triangles.size());
+  for (const auto& [w, list] : byOther)
+  {
+    (void)w;
+    for (std::size_t i = 1; i < list.size(); ++i)
+    {
+      local.unite(static_cast<std::uint32_t>(list[0]), static_cast<std::uint32_t>(list[i]));
+    }
+  }
+  std::map<std::uint32_t, std::size_t> fanOfRoot;
+  std::vector<std::vector<std::uint32_t>> fans;
+  for (std::uint32_t i = 0; i < triangles.size(); ++i)
+  {
+    const auto [it, added] = fanOfRoot.emplace(local.find(i), fans.size());
+    if (added)
+    {
+      fans.emplace_back();
+    }
+    fans[it->second].push_back(triangles[i]);
+  }
+  return fans;
 }
 
 } // namespace
@@ -99,54 +158,11 @@ MeshTopology analyzeTopology(const SurfaceMesh& mesh)
     }
   }
   // A manifold vertex: its incident triangles, linked through shared edges around it, form one
-  // fan. Count fans per vertex with a union-find over the vertex's triangles.
-  std::vector<std::vector<std::uint32_t>> vertexTriangles(mesh.points.size());
-  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
-  {
-    const auto& tri = mesh.triangles[f];
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
-    {
-      continue;
-    }
-    for (auto v : tri)
-    {
-      vertexTriangles[v].push_back(f);
-    }
-  }
+  // fan.
+  const std::vector<std::vector<std::uint32_t>> around = trianglesAroundVertices(mesh);
   for (std::uint32_t v = 0; v < mesh.points.size(); ++v)
   {
-    const auto& fan = vertexTriangles[v];
-    if (fan.size() < 2)
-    {
-      continue;
-    }
-    // Triangles around v are linked when they share an edge (v, w).
-    std::map<std::uint32_t, std::vector<std::size_t>> byOther;
-    for (std::size_t i = 0; i < fan.size(); ++i)
-    {
-      for (auto w : mesh.triangles[fan[i]])
-      {
-        if (w != v)
-        {
-          byOther[w].push_back(i);
-        }
-      }
-    }
-    UnionFind local(fan.size());
-    for (const auto& [w, list] : byOther)
-    {
-      (void)w;
-      for (std::size_t i = 1; i < list.size(); ++i)
-      {
-        local.unite(static_cast<std::uint32_t>(list[0]), static_cast<std::uint32_t>(list[i]));
-      }
-    }
-    std::size_t fans = 0;
-    for (std::uint32_t i = 0; i < fan.size(); ++i)
-    {
-      fans += local.find(i) == i ? 1 : 0;
-    }
-    if (fans > 1)
+    if (fansAround(mesh, v, around[v]).size() > 1)
     {
       ++t.nonManifoldVertices;
     }
@@ -162,6 +178,43 @@ MeshTopology analyzeTopology(const SurfaceMesh& mesh)
   t.eulerCharacteristic = static_cast<long>(t.vertices) - static_cast<long>(t.edges) +
     static_cast<long>(t.triangles - t.degenerateTriangles);
   return t;
+}
+
+std::vector<std::uint32_t> splitNonManifoldVertices(SurfaceMesh& mesh)
+{
+  const std::vector<std::vector<std::uint32_t>> around = trianglesAroundVertices(mesh);
+  std::vector<std::uint32_t> copied;
+  const auto n = static_cast<std::uint32_t>(mesh.points.size());
+  for (std::uint32_t v = 0; v < n; ++v)
+  {
+    const auto fans = fansAround(mesh, v, around[v]);
+    // The first fan keeps v; every other one gets a copy of it at the same place.
+    for (std::size_t k = 1; k < fans.size(); ++k)
+    {
+      const auto copy = static_cast<std::uint32_t>(mesh.points.size());
+      mesh.points.push_back(mesh.points[v]);
+      for (PointArray& a : mesh.pointData)
+      {
+        const auto c = static_cast<std::size_t>(a.components);
+        for (std::size_t j = 0; j < c; ++j)
+        {
+          a.values.push_back(a.values[v * c + j]);
+        }
+      }
+      copied.push_back(v);
+      for (std::uint32_t f : fans[k])
+      {
+        for (auto& corner : mesh.triangles[f])
+        {
+          if (corner == v)
+          {
+            corner = copy;
+          }
+        }
+      }
+    }
+  }
+  return copied;
 }
 
 namespace

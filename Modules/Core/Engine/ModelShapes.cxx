@@ -122,7 +122,11 @@ std::shared_ptr<const skin::SkinnedMesh> readSkinned(const ShapeCall& s)
   const std::string path = lang::modelFilePath(s.m.model, s.args[0].text);
   try
   {
-    auto mesh = std::make_shared<const skin::SkinnedMesh>(skin::readSkinnedMesh(path));
+    // A surface whose patches touch at corners becomes a B-cell with those corners split
+    // (skin::splitNonManifoldVertices), as the checker reads it.
+    skin::SkinnedMesh read = skin::readSkinnedMesh(path);
+    skin::splitNonManifoldVertices(read);
+    auto mesh = std::make_shared<const skin::SkinnedMesh>(std::move(read));
     s.c.skinAnimation = &mesh->animation(s.args[1].text);
     s.c.skinned = mesh;
     return mesh;
@@ -337,8 +341,7 @@ void ModelState::fitStandIns()
           "' is not one (shape = loadMesh(...))");
     try
     {
-      skin::StandIn standIn = skin::initialStandIn(*mesh.skinned);
-      skin::fitStandIn(standIn, mesh.skinned->restPoints);
+      skin::StandIn standIn = skin::fittedStandIn(*mesh.skinned);
       c.projection =
         std::make_shared<const skin::Projection>(skin::projectOntoStandIn(*mesh.skinned, standIn));
       c.standIn = std::make_shared<const skin::StandIn>(std::move(standIn));

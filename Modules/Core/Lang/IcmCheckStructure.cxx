@@ -467,7 +467,9 @@ const skin::SkinnedMesh* Checker::skinnedMesh(const Expr& path, bool report)
     std::string problem;
     try
     {
-      mesh = std::make_shared<const skin::SkinnedMesh>(skin::readSkinnedMesh(file));
+      skin::SkinnedMesh read = skin::readSkinnedMesh(file);
+      skin::splitNonManifoldVertices(read);
+      mesh = std::make_shared<const skin::SkinnedMesh>(std::move(read));
     }
     catch (const std::exception& e)
     {
@@ -516,8 +518,9 @@ void Checker::loadMesh(const Expr& call, bool surface)
   {
     return;
   }
-  // A B-cell's surface must be a manifold (complex::checkCell): many characters are not. A
-  // skeleton's segments need no surface.
+  // A B-cell's surface must be a manifold (complex::checkCell): corners where patches touch are
+  // split when the file is read (skinnedMesh), edges of three or more triangles are refused here.
+  // A skeleton's segments need no surface.
   try
   {
     if (surface)

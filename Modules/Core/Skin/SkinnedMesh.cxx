@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Skin/SkinnedMesh.h"
 
+#include "Discretize/MeshRepair.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -156,6 +158,31 @@ const Animation& SkinnedMesh::animation(const std::string& name) const
   fail(*this,
     "no animation named '" + name + "' (" +
       (animations.empty() ? std::string("the file has no animation") : "it has " + names) + ")");
+}
+
+std::size_t splitNonManifoldVertices(SkinnedMesh& mesh)
+{
+  discretize::SurfaceMesh surface;
+  surface.points = mesh.restPoints;
+  for (const auto& t : mesh.triangles)
+    surface.triangles.push_back({ static_cast<std::uint32_t>(t[0]),
+      static_cast<std::uint32_t>(t[1]), static_cast<std::uint32_t>(t[2]) });
+  const std::vector<std::uint32_t> copied = discretize::splitNonManifoldVertices(surface);
+  // A copy is the same vertex for skinning: its normal and influences too.
+  for (const std::uint32_t v : copied)
+  {
+    mesh.restPoints.push_back(mesh.restPoints[v]);
+    if (!mesh.restNormals.empty())
+      mesh.restNormals.push_back(mesh.restNormals[v]);
+    for (std::size_t k = mesh.influenceStart[v]; k < mesh.influenceStart[v + 1]; ++k)
+      mesh.influences.push_back(mesh.influences[k]);
+    mesh.influenceStart.push_back(mesh.influences.size());
+  }
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      mesh.triangles[t][static_cast<std::size_t>(k)] =
+        static_cast<int>(surface.triangles[t][static_cast<std::size_t>(k)]);
+  return copied.size();
 }
 
 std::vector<Influence> SkinnedMesh::dominantInfluences() const

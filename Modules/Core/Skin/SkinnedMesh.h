@@ -124,6 +124,14 @@ struct SkinnedMesh
   void validate() const;
 };
 
+/// Makes the surface a manifold where only corners are shared: a vertex that joins separate fans
+/// of triangles (patches of a character touching at one corner, left by its texture seams, as in
+/// BCN_Epileptic.X) gets a copy per extra fan (discretize::splitNonManifoldVertices) carrying its
+/// normal and influences, so the surface and its skinning do not change; the copies are appended
+/// after the file's vertices. Returns how many vertices were added. A B-cell needs this
+/// (complex::checkCell); the counts of the file (`assimp info`) are those before it.
+std::size_t splitNonManifoldVertices(SkinnedMesh& mesh);
+
 /// A bone of the rigging skeleton: a joint and its parent joint (the joint of its node's nearest
 /// ancestor that is one), as indices into SkinnedMesh::joints.
 struct Bone
