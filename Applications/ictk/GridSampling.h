@@ -18,7 +18,8 @@
 namespace CLI
 {
 class App;
-}
+class Option;
+} // namespace CLI
 class vtkImageData;
 class vtkPolyData;
 

@@ -84,7 +84,7 @@ ResolvedModel ResolveModel(
   if (!lang::isModelFile(nameOrPath))
   {
     const frep::ModelInfo& info = FindModel(nameOrPath);
-    return { info.name, info.build(), info.boundsLo, info.boundsHi };
+    return { info.name, info.build(), info.boundsLo, info.boundsHi, nullptr };
   }
   if (lang::isBlobFile(nameOrPath))
   {
@@ -107,16 +107,18 @@ ResolvedModel ResolveModel(
           "' is an animated BlobTree: give the time to instantiate it at, --time t (or --frames "
           "T0:T1:DT where the command takes it; docs/blobtree.md)");
       }
-      ResolvedModel model{ blob->name, {}, {}, {}, blob };
-      return model.At(*time);
+      lang::ModelFile file = blob->at(*time);
+      const std::array<double, 6> b = *file.bounds;
+      return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] }, blob };
     }
     lang::ModelFile file = blob->at(0.0);
     const std::array<double, 6> b = *file.bounds;
-    return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] } };
+    return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] },
+      nullptr };
   }
   lang::ModelFile file = OpenModelFile(nameOrPath, params);
   const std::array<double, 6> b = lang::modelFileBounds(file, params);
-  return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] } };
+  return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] }, nullptr };
 }
 
 bool IsComplexInput(const std::string& path)
