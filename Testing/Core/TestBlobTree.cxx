@@ -902,3 +902,66 @@ TEST(BlobTree, SurfaceOfRevolution)
   EXPECT_THROW(bad.add(Kind::SurfaceOfRevolution, { R, 1, 0, 0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0 }),
     std::invalid_argument); // no segment
 }
+
+// Item 49: surfaces with variable thickness (papers.md 3.4, lines 127-140), numbers by hand on
+// the triangle (0, 0, 0), (2, 0, 0), (0, 2, 0) with thicknesses 0.2, 0.4, 0.2: its top is the
+// plane through v + t n, z = 0.2 + 0.1 x.
+TEST(BlobTree, SurfaceWithVariableThickness)
+{
+  const double R = 1.5;
+  BlobTree s;
+  s.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0.2, 2, 0, 0, 0.4, 0, 2, 0, 0.2 });
+  const BlobTree e = s.expand();
+  EXPECT_EQ(e.count(Kind::ThickTriangle), 1u);
+  // Over the triangle, d = |h| - t(q): at (0.5, 0.5) the barycentric coordinates are
+  // (0.5, 0.25, 0.25), t = 0.25.
+  EXPECT_NEAR(evaluate(s, { 0.5, 0.5, 0.5 }), wyvillByHand(0.25, R), 1e-12);
+  EXPECT_NEAR(evaluate(s, { 0.5, 0.5, -0.5 }), wyvillByHand(0.25, R), 1e-12);
+  EXPECT_DOUBLE_EQ(evaluate(s, { 0.5, 0.5, 0.1 }), 1.0); // inside the slab
+  EXPECT_DOUBLE_EQ(evaluate(s, { 1, 0.5, 0.3 }), 1.0);   // on the top plane z = 0.2 + 0.1 x
+  EXPECT_NEAR(evaluate(s, { 1, 0.5, 0.8 }), wyvillByHand(0.5, R), 1e-12);
+  // Beyond edge ab: from its nearest point (1, 0, 0), where t = 0.3: d = 0.5 - 0.3.
+  EXPECT_NEAR(evaluate(s, { 1, -0.5, 0 }), wyvillByHand(0.2, R), 1e-12);
+  // Beyond vertex b: d = |p - b| - 0.4.
+  EXPECT_NEAR(evaluate(s, { 2.6, -0.8, 0 }), wyvillByHand(0.6, R), 1e-12);
+  // Null thickness is the triangle element (line 139).
+  BlobTree thin;
+  thin.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0 });
+  EXPECT_EQ(thin.expand().count(Kind::Triangle), 1u);
+  const BlobTree triangle = single(Kind::Triangle, { R, 1, 0, 0, 0, 2, 0, 0, 0, 2, 0 });
+  // Equal thickness, the prism: d = |h| - 0.3 over the triangle.
+  BlobTree prism;
+  prism.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0.3, 2, 0, 0, 0.3, 0, 2, 0, 0.3 });
+  std::mt19937 rng(49);
+  std::uniform_real_distribution<double> x(-1.5, 3);
+  for (int k = 0; k < 300; ++k)
+  {
+    const Vec3 p{ x(rng), x(rng), x(rng) };
+    ASSERT_NEAR(evaluate(thin, p), evaluate(triangle, p), 1e-12);
+    if (p[0] > 0 && p[1] > 0 && p[0] + p[1] < 2)
+    {
+      ASSERT_NEAR(evaluate(prism, p), wyvillByHand(std::max(std::fabs(p[2]) - 0.3, 0.0), R), 1e-12);
+    }
+  }
+  // A folded surface of two triangles sharing the edge (0, 0, 0)-(0, 2, 0): two elements under a
+  // max node, and no crack along the fold: on the shared edge's rounded side both give the same.
+  BlobTree fold;
+  fold.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0.1, 2, 0, 0, 0.1, 0, 2, 0, 0.1, 0, 0, 0, 0.1,
+                                   0, 2, 0, 0.1, -1, 0, 1.5, 0.1 });
+  const BlobTree folded = fold.expand();
+  EXPECT_EQ(folded.count(Kind::ThickTriangle), 2u);
+  EXPECT_EQ(folded.count(Kind::Max), 1u);
+  EXPECT_NEAR(evaluate(fold, { -0.3, 1, -0.3 }), wyvillByHand(std::sqrt(0.18) - 0.1, R), 1e-12);
+  // The lowered field agrees with the traversal.
+  PointEvaluator pe(Tape::compile(potential(fold)));
+  for (int k = 0; k < 500; ++k)
+  {
+    const Vec3 p{ x(rng), x(rng), x(rng) };
+    ASSERT_NEAR(pe.eval(p[0], p[1], p[2]), evaluate(fold, p), 1e-12);
+  }
+  BlobTree bad;
+  EXPECT_THROW(bad.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0 }),
+    std::invalid_argument); // collinear
+  EXPECT_THROW(bad.add(Kind::ThickSurface, { R, 1, 0, 0, 0, -1, 2, 0, 0, 0, 0, 2, 0, 0 }),
+    std::invalid_argument); // negative thickness
+}

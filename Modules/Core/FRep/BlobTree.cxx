@@ -43,6 +43,10 @@ inline double sqrt(double a)
 {
   return std::sqrt(a);
 }
+inline double abs(double a)
+{
+  return std::fabs(a);
+}
 inline double pow(double a, double b)
 {
   return std::pow(a, b);
@@ -173,6 +177,37 @@ S triangleDistance2(const P<S>& p, const double* a, const double* b, const doubl
   return select(inside, square(dot(minus(p, a), nn)), edges);
 }
 
+// The thick triangle: over the triangle |h| - t(q) with t interpolated by the barycentric
+// coordinates of the foot q; beyond an edge (P, Q) the distance to its nearest point minus the
+// thickness there, the least over the three edges. Both agree on the planes through the edges
+// perpendicular to the triangle, where the regions meet.
+template <class S>
+S thickTriangleDistance(const P<S>& p, const double* v)
+{
+  const double* corner[3] = { v, v + 3, v + 6 };
+  const double t[3] = { v[9], v[10], v[11] };
+  const Vec3 n = vcross(vsub(v + 3, v), vsub(v + 6, v));
+  const double n2 = vdot(n, n);
+  // Edge functions: w_k is the barycentric coordinate of the vertex opposite edge k.
+  S inside(0.0), edges(0.0), thickness(0.0);
+  for (int k = 0; k < 3; ++k)
+  {
+    const double* from = corner[k];
+    const double* to = corner[(k + 1) % 3];
+    const S w = dot(minus(p, from), vcross(n, vsub(to, from))) * (1.0 / n2);
+    thickness = k == 0 ? w * t[2] : thickness + w * t[(k + 2) % 3];
+    inside = k == 0 ? w : min(inside, w);
+    const Vec3 e = vsub(to, from);
+    const S u = min(max(dot(minus(p, from), e) * (1.0 / vdot(e, e)), S(0.0)), S(1.0));
+    const S de = sqrt(square(p.x - from[0] - u * e[0]) + square(p.y - from[1] - u * e[1]) +
+                   square(p.z - from[2] - u * e[2])) -
+      (t[k] + u * (t[(k + 1) % 3] - t[k]));
+    edges = k == 0 ? de : min(edges, de);
+  }
+  const S h = abs(dot(minus(p, v), vscale(n, 1.0 / std::sqrt(n2))));
+  return select(inside, h - thickness, edges);
+}
+
 // Squared distance of an element's skeleton (the values after R and i).
 template <class S>
 S skeletonDistance2(Kind kind, const double* v, std::uint32_t count, const P<S>& p)
@@ -203,6 +238,8 @@ S skeletonDistance2(Kind kind, const double* v, std::uint32_t count, const P<S>&
                        : square(max(sqrt(segmentDistance2(p, v, v + 3)) - v[6], S(0.0)));
     case Kind::ConeSphere:
       return square(max(coneSphereDistance(p, v, v + 3, v[6], v[7]), S(0.0)));
+    case Kind::ThickTriangle:
+      return square(max(thickTriangleDistance(p, v), S(0.0)));
     case Kind::HollowCone:
     {
       // The 2D cone-sphere in the meridian half-plane (rho, h) of the point.
@@ -274,6 +311,12 @@ Box elementBox(Kind kind, const double* values, std::uint32_t count)
     case Kind::ConeSphere:
       grow(b, vec(v), v[6] + R);
       grow(b, vec(v + 3), v[7] + R);
+      break;
+    case Kind::ThickTriangle:
+      for (int k = 0; k < 3; ++k)
+      {
+        grow(b, vec(v + 3 * k), std::max({ v[9], v[10], v[11] }) + R);
+      }
       break;
     case Kind::HollowCone:
     {
@@ -591,8 +634,10 @@ const Rule& rule(Kind kind)
     { "cylinder", 9, 0, 0, 0, 0 },
     { "conesphere", 10, 0, 0, 0, 0 },
     { "hollowcone", 14, 0, 0, 0, 0 },
+    { "thicktriangle", 14, 0, 0, 0, 0 },
     { "gcylinder", 3, 4, 2, 0, 0 },
     { "revolution", 9, 3, 2, 0, 0 },
+    { "thicksurface", 2, 12, 1, 0, 0 },
     { "blend", 0, 0, 0, 1, 0 },
     { "hyperblend", 1, 0, 0, 1, 0 },
     { "localblend", 0, 0, 0, 3, 3 },
@@ -687,6 +732,34 @@ void checkValues(Kind kind, const double* v, std::uint32_t count)
       }
       break;
     }
+    case Kind::ThickTriangle:
+    {
+      const Vec3 n = vcross(vsub(s + 3, s), vsub(s + 6, s));
+      if (!(vdot(n, n) > 0))
+      {
+        fail(kind, "the three vertices must not be collinear");
+      }
+      for (int k = 9; k < 12; ++k)
+      {
+        requireNonNegative(kind, "every thickness", s[k]);
+      }
+      break;
+    }
+    case Kind::ThickSurface:
+      for (std::uint32_t k = 2; k + 12 <= count; k += 12)
+      {
+        const double* tri = v + k;
+        const Vec3 n = vcross(vsub(tri + 4, tri), vsub(tri + 8, tri));
+        if (!(vdot(n, n) > 0))
+        {
+          fail(kind, "triangle " + std::to_string((k - 2) / 12) + " is degenerate (collinear)");
+        }
+        for (int q = 3; q < 12; q += 4)
+        {
+          requireNonNegative(kind, "every thickness", tri[q]);
+        }
+      }
+      break;
     case Kind::HollowCone:
       if (vdot(vec(s + 3), vec(s + 3)) == 0)
       {
@@ -769,11 +842,12 @@ const char* kindName(Kind kind)
 }
 bool isSkeletal(Kind kind)
 {
-  return kind <= Kind::HollowCone;
+  return kind <= Kind::ThickTriangle;
 }
 bool isComplexPrimitive(Kind kind)
 {
-  return kind == Kind::GeneralisedCylinder || kind == Kind::SurfaceOfRevolution;
+  return kind == Kind::GeneralisedCylinder || kind == Kind::SurfaceOfRevolution ||
+    kind == Kind::ThickSurface;
 }
 bool isWarp(Kind kind)
 {

@@ -67,6 +67,12 @@ enum class Kind : std::uint8_t
               /// (major radius rho_i, minor t_i), rho0 = rho1 gives the cylinder of line 159 and t0
               /// = t1 = 0 the plain hollow cone.
   HollowCone,
+  /// R i | a b c ta tb tc: a triangle with a thickness at each vertex (>= 0; papers.md 3.4, lines
+  /// 127-140): d = |h| - t(q) over the triangle (h the height, t interpolated at the foot q), and
+  /// |p - q| - t(q) from the nearest point q of an edge beyond it. Its top and bottom are the
+  /// planes through v +- t n; its sides are rounded (the paper's polyhedron has flat sides), so
+  /// that neighbouring triangles of a surface meet without cracks. Null thickness: the triangle.
+  ThickTriangle,
   // --- complex skeletal primitive (expanded into leaves by expand(), papers.md 3.4)
   // ---
   GeneralisedCylinder, ///< R i n | (v r)...  (control points with radii, >= 2; n >= 1 segments)
@@ -76,6 +82,10 @@ enum class Kind : std::uint8_t
                        /// `axis`, h the height, t >= 0 the thickness), sampled into n segments (the
                        /// level of detail), each a HollowCone, joined by max nodes (no bulging).
   SurfaceOfRevolution,
+  /// R i | (a ta b tb c tc)...: a surface with variable thickness (papers.md 3.4, lines 127-140),
+  /// a triangle mesh given triangle by triangle, each vertex with its thickness: one ThickTriangle
+  /// per triangle (a Triangle where all three thicknesses are null), joined by max nodes.
+  ThickSurface,
   // --- operators ---
   Blend,        ///< sum of >= 1 children (papers.md 3.3, line 66)
   HyperBlend,   ///< n | (sum f^n)^(1/n) of >= 1 children, n > 0 (line 70)

@@ -224,6 +224,31 @@ void BlobTree::touch()
   instanceOf_ = 0;
 }
 
+namespace
+{
+// A balanced tree of binary max nodes over the pieces (line 114: the union, no bulging; line
+// 125: a hierarchy that follows the pieces' order, so spatial neighbours share subtrees).
+template <class Push>
+std::uint32_t joinUnderMax(
+  std::vector<std::uint32_t>& level, std::vector<std::uint32_t>& next, Push& push)
+{
+  while (level.size() > 1)
+  {
+    next.clear();
+    for (std::size_t k = 0; k + 1 < level.size(); k += 2)
+    {
+      next.push_back(push(Kind::Max, nullptr, 0, 0, &level[k], 2));
+    }
+    if (level.size() % 2)
+    {
+      next.push_back(level.back());
+    }
+    level.swap(next);
+  }
+  return level[0];
+}
+} // namespace
+
 void BlobTree::instantiate(double t, BlobTree& out) const
 {
   double threshold = threshold_;
@@ -293,6 +318,38 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     //
     // Surface of revolution (lines 150-159): the profile (rho, h, t) sampled the same way, each
     // segment a HollowCone (its ends are the junction tori), under the same union tree.
+    if (n.kind == Kind::ThickSurface)
+    {
+      // Surface with variable thickness (lines 127-140): a thick triangle per triangle, a plain
+      // triangle where its three thicknesses are null (line 139), in slots of 14 values.
+      level.clear();
+      for (std::uint32_t k = 2; k + 12 <= n.valueCount; k += 12)
+      {
+        const double* tri = nv + k;
+        const bool thin = tri[3] == 0 && tri[7] == 0 && tri[11] == 0;
+        const double pieceValues[14] = { nv[0], nv[1], tri[0], tri[1], tri[2], tri[4], tri[5],
+          tri[6], tri[8], tri[9], tri[10], tri[3], tri[7], tri[11] };
+        const Kind kind = thin ? Kind::Triangle : Kind::ThickTriangle;
+        const std::uint32_t count = thin ? 11 : 14;
+        if (relayout)
+        {
+          level.push_back(push(kind, pieceValues, count, 14, nullptr, 0));
+          out.pieces_.push_back(level.back());
+        }
+        else
+        {
+          Node& leaf = out.nodes_[out.pieces_[piece++]];
+          leaf.kind = kind;
+          leaf.valueCount = count;
+          std::copy(pieceValues, pieceValues + 14, out.values_.data() + leaf.firstValue);
+        }
+      }
+      if (relayout)
+      {
+        map[i] = joinUnderMax(level, next, push);
+      }
+      continue;
+    }
     const bool revolution = n.kind == Kind::SurfaceOfRevolution;
     const auto segments = static_cast<std::uint32_t>(nv[2]);
     const double* ctrl = nv + 3;
@@ -344,20 +401,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     {
       continue;
     }
-    while (level.size() > 1)
-    {
-      next.clear();
-      for (std::size_t k = 0; k + 1 < level.size(); k += 2)
-      {
-        next.push_back(push(Kind::Max, nullptr, 0, 0, &level[k], 2));
-      }
-      if (level.size() % 2)
-      {
-        next.push_back(level.back());
-      }
-      level.swap(next);
-    }
-    map[i] = level[0];
+    map[i] = joinUnderMax(level, next, push);
   }
   out.root_ = map[root_];
   out.instanceOf_ = structure_;

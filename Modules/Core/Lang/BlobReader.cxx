@@ -464,10 +464,14 @@ private:
     {
       elements = (values.size() - 5) / 3;
     }
-    if (frep::blob::isComplexPrimitive(*kind) && values.size() >= 3 && values[2] >= 1 &&
-      values[2] <= 100000)
+    if (frep::blob::isComplexPrimitive(*kind) && *kind != Kind::ThickSurface &&
+      values.size() >= 3 && values[2] >= 1 && values[2] <= 100000)
     {
       elements = static_cast<std::size_t>(values[2]);
+    }
+    if (*kind == Kind::ThickSurface && values.size() >= 2)
+    {
+      elements = (values.size() - 2) / 12; // a triangle each
     }
     // A solid texture's noise lowers to some 150 expression nodes an octave.
     if (frep::blob::isTexture(*kind) && *kind != Kind::Material && values.size() == 12 &&
