@@ -946,8 +946,9 @@ TEST(BlobTree, SurfaceWithVariableThickness)
   // A folded surface of two triangles sharing the edge (0, 0, 0)-(0, 2, 0): two elements under a
   // max node, and no crack along the fold: on the shared edge's rounded side both give the same.
   BlobTree fold;
-  fold.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0.1, 2, 0, 0, 0.1, 0, 2, 0, 0.1, 0, 0, 0, 0.1,
-                                   0, 2, 0, 0.1, -1, 0, 1.5, 0.1 });
+  fold.add(Kind::ThickSurface,
+    { R, 1, 0, 0, 0, 0.1, 2, 0, 0, 0.1, 0, 2, 0, 0.1, 0, 0, 0, 0.1, 0, 2, 0, 0.1, -1, 0, 1.5,
+      0.1 });
   const BlobTree folded = fold.expand();
   EXPECT_EQ(folded.count(Kind::ThickTriangle), 2u);
   EXPECT_EQ(folded.count(Kind::Max), 1u);
