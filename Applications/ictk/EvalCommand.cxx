@@ -14,6 +14,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace ictk::cli
 {
@@ -63,7 +64,10 @@ public:
       p[3] = o.Time;
     }
     const std::vector<double> params = ParseParameters(o.Params);
-    const ResolvedModel model = ResolveModel(o.Model, params);
+    // An animated .blob is instantiated at the point's time, when the command gives one.
+    const bool timed = at.size() > 3 || this->TimeOption->count() > 0;
+    const ResolvedModel model =
+      ResolveModel(o.Model, params, timed ? std::optional<double>(p[3]) : std::nullopt);
 
     const frep::Hypervolume& hv = model.Model;
     std::vector<double> attributes(hv.attributeComponentCount());

@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace ictk::cli
@@ -121,7 +122,7 @@ void GridCommandOptions::AddTo(CLI::App* command, std::int64_t defaultResolution
   resolution->excludes(dims);
   command->add_option(
     "--bounds", this->Bounds, "Sampled box x0,x1,y0,y1,z0,z1 (default: the model's bounds)");
-  AddTime(command, this->Time);
+  this->TimeOption = AddTime(command, this->Time);
   AddThreads(command, this->Threads);
   AddParams(command, this->Params);
   command->add_flag("--space-time", this->SpaceTime,
@@ -129,13 +130,36 @@ void GridCommandOptions::AddTo(CLI::App* command, std::int64_t defaultResolution
     "thesis's figures of space-time blending); --bounds' z0,z1 are then the time range");
 }
 
-GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue)
+GridPlan PlanGrid(
+  const GridCommandOptions& o, std::size_t bytesPerValue, const std::vector<double>& frames)
 {
   const std::vector<double> params = ParseParameters(o.Params);
-  GridPlan plan{ ResolveModel(o.Model, params), params, {}, {} };
   if (!std::isfinite(o.Time))
   {
     throw UserError("--time must be a finite number");
+  }
+  std::optional<double> time;
+  if (!frames.empty())
+  {
+    time = frames.front();
+  }
+  else if (o.TimeOption && o.TimeOption->count() > 0)
+  {
+    time = o.Time;
+  }
+  GridPlan plan{ ResolveModel(o.Model, params, time), params, {}, {} };
+  if (plan.Model.Animated)
+  {
+    // One grid for the whole series: it holds the model at every frame.
+    for (std::size_t k = 1; k < frames.size(); ++k)
+    {
+      const ResolvedModel at = plan.Model.At(frames[k]);
+      for (int a = 0; a < 3; ++a)
+      {
+        plan.Model.Lo[a] = std::min(plan.Model.Lo[a], at.Lo[a]);
+        plan.Model.Hi[a] = std::max(plan.Model.Hi[a], at.Hi[a]);
+      }
+    }
   }
   CheckThreads(o.Threads);
   if (o.SpaceTime)
@@ -222,14 +246,22 @@ vtkSmartPointer<ictkFRepSampler> PlannedSampler(
   const GridPlan& plan, int threads, bool asDouble, bool attributes)
 {
   vtkNew<ictkFRepSampler> sampler;
-  sampler->SetHypervolume(plan.Model.Model);
+  sampler->SetTime(plan.Grid.time);
+  if (plan.Model.Animated)
+  {
+    // An animated .blob changes outside its domain: its instance at each frame's time.
+    sampler->SetHypervolumeOfTime([model = plan.Model](double t) { return model.At(t).Model; });
+  }
+  else
+  {
+    sampler->SetHypervolume(plan.Model.Model);
+  }
   sampler->SetParameters(plan.Params);
   const auto& lo = plan.Model.Lo;
   const auto& hi = plan.Model.Hi;
   sampler->SetModelBounds(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
   sampler->SetSampleDimensions(
     static_cast<int>(plan.Dims[0]), static_cast<int>(plan.Dims[1]), static_cast<int>(plan.Dims[2]));
-  sampler->SetTime(plan.Grid.time);
   sampler->SetNumberOfThreads(threads);
   sampler->SetOutputScalarType(asDouble ? VTK_DOUBLE : VTK_FLOAT);
   sampler->SetComputeAttributes(attributes);

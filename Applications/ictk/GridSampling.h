@@ -18,7 +18,8 @@
 namespace CLI
 {
 class App;
-}
+class Option;
+} // namespace CLI
 class vtkImageData;
 class vtkPolyData;
 
@@ -37,6 +38,7 @@ struct GridCommandOptions
   std::string Dims;
   std::string Bounds;
   double Time = 0;
+  CLI::Option* TimeOption = nullptr; ///< whether --time was given (an animated .blob needs it)
   int Threads = 0;
   std::string Params;
   /// An XYT model (2D over time) sampled as the 3D solid of its space-time, z standing for t
@@ -57,8 +59,12 @@ struct GridPlan
 };
 
 /// Resolves the model and checks the grid (bounds, dimensions, the memory it needs at
-/// `bytesPerValue` per value of f and of every attribute component).
-GridPlan PlanGrid(const GridCommandOptions& o, std::size_t bytesPerValue);
+/// `bytesPerValue` per value of f and of every attribute component). `frames`: the times of a
+/// series (sample --frames), at the first of which an animated .blob is resolved, its bounds
+/// then the union of its boxes at every frame; else an animated .blob is resolved at --time and
+/// refused without it.
+GridPlan PlanGrid(
+  const GridCommandOptions& o, std::size_t bytesPerValue, const std::vector<double>& frames = {});
 
 /// Samples the planned grid with a progress display; null when interrupted (Ctrl-C, inside the
 /// caller's InterruptScope).
@@ -67,7 +73,8 @@ vtkSmartPointer<vtkImageData> SampleImage(const GridPlan& plan, int threads, boo
 
 /// Samples the planned grid of a time-dependent model at every time into the ParaView time series
 /// `pvd` (ictkTimeSeriesWriter: one .vti a frame, written atomically), with a progress display;
-/// false when interrupted (nothing written). A model without time is a UserError.
+/// false when interrupted (nothing written). A model without time is a UserError; an animated
+/// .blob is instantiated at every time.
 bool SampleSeries(const GridPlan& plan, int threads, bool asDouble,
   const std::vector<double>& times, const std::string& pvd, ictkCaptureOutputWindow* messages);
 

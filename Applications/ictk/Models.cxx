@@ -67,7 +67,20 @@ lang::ModelFile OpenModelFile(const std::string& path, const std::vector<double>
   }
 }
 
-ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<double>& params)
+ResolvedModel ResolvedModel::At(double t) const
+{
+  if (!this->Animated)
+  {
+    return *this;
+  }
+  lang::ModelFile file = this->Animated->at(t);
+  const std::array<double, 6> b = *file.bounds;
+  return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] },
+    this->Animated };
+}
+
+ResolvedModel ResolveModel(
+  const std::string& nameOrPath, const std::vector<double>& params, std::optional<double> time)
 {
   // A complex or a dynamic model is not one FRep model: say which commands take it rather than
   // "unknown model".
@@ -83,11 +96,41 @@ ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<doub
   if (!lang::isModelFile(nameOrPath))
   {
     const frep::ModelInfo& info = FindModel(nameOrPath);
-    return { info.name, info.build(), info.boundsLo, info.boundsHi };
+    return { info.name, info.build(), info.boundsLo, info.boundsHi, nullptr };
+  }
+  if (lang::isBlobFile(nameOrPath))
+  {
+    std::shared_ptr<const lang::BlobModelFile> blob;
+    try
+    {
+      blob = std::make_shared<const lang::BlobModelFile>(lang::loadBlobModelFile(nameOrPath));
+    }
+    catch (const lang::ParseError& e)
+    {
+      throw AsModelFileError(e);
+    }
+    if (blob->animated())
+    {
+      // Reading an animated tree at t = 0 for want of a time would answer a question about
+      // another time: the time must be given.
+      if (!time)
+      {
+        throw UserError("'" + nameOrPath +
+          "' is an animated BlobTree: give the time to instantiate it at, --time t (or --frames "
+          "T0:T1:DT where the command takes it; docs/blobtree.md)");
+      }
+      lang::ModelFile file = blob->at(*time);
+      const std::array<double, 6> b = *file.bounds;
+      return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] }, blob };
+    }
+    lang::ModelFile file = blob->at(0.0);
+    const std::array<double, 6> b = *file.bounds;
+    return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] },
+      nullptr };
   }
   lang::ModelFile file = OpenModelFile(nameOrPath, params);
   const std::array<double, 6> b = lang::modelFileBounds(file, params);
-  return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] } };
+  return { file.name, std::move(file.model), { b[0], b[2], b[4] }, { b[1], b[3], b[5] }, nullptr };
 }
 
 bool IsComplexInput(const std::string& path)

@@ -14,6 +14,8 @@
 #include "Lang/ModelFile.h"
 
 #include <array>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,10 +43,19 @@ struct ResolvedModel
   frep::Hypervolume Model;
   std::array<double, 3> Lo;
   std::array<double, 3> Hi;
+  /// An animated .blob (docs/blobtree.md), which changes with time outside its domain: Model,
+  /// Lo and Hi are then its instance at the time it was resolved at, and At() gives the others.
+  std::shared_ptr<const lang::BlobModelFile> Animated;
+  /// The model at time t: the instance of an animated .blob at t; any other model as it is (an
+  /// XYZT model takes t at evaluation).
+  ResolvedModel At(double t) const;
 };
 
-/// A registered model's name or a model file (.hf, .xml).
-ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<double>& params);
+/// A registered model's name or a model file (.hf, .xml, .scn, .vm, .blob). An animated .blob is
+/// instantiated at `time`; without one it is refused (a UserError saying to give --time or
+/// --frames), never read at t = 0.
+ResolvedModel ResolveModel(const std::string& nameOrPath, const std::vector<double>& params,
+  std::optional<double> time = std::nullopt);
 
 /// True for a complex (.json) input.
 bool IsComplexInput(const std::string& path);

@@ -145,9 +145,11 @@ public:
       "parallel_scale (half the height seen); instead of --view and --projection");
     this->TimeOption = AddTime(render, this->Time);
     this->TimeOption->description(
-      "Time t of an XYZT model or a .icm model (default 0; a .icm model's start)");
+      "Time t of an XYZT model, an animated .blob or a .icm model (default 0; a .icm model's "
+      "start; an animated .blob needs it)");
     AddFrames(render, this->Frames,
-      "Frames T0:T1:DT of an XYZT or .icm model, one picture each (-o a pattern or an .mp4)");
+      "Frames T0:T1:DT of an XYZT model, an animated .blob or a .icm model, one picture each (-o "
+      "a pattern or an .mp4)");
     render->add_option("--fps", this->Fps, "Frames per second of an .mp4 film (default 1/DT)");
     AddThreads(render, this->Threads);
     AddParams(render, this->Params);
@@ -483,10 +485,21 @@ private:
     }
   }
 
-  /// The FRep model to ray cast, in its box or --bounds'.
-  ResolvedModel ModelToDraw() const
+  /// The FRep model to ray cast, in its box or --bounds'. An animated .blob is resolved at
+  /// `times`' first (--time, or the first frame), its box then the union of its boxes at all.
+  ResolvedModel ModelToDraw(const std::vector<double>& times) const
   {
-    ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params));
+    ResolvedModel model = ResolveModel(this->Model, ParseParameters(this->Params),
+      times.empty() ? std::nullopt : std::optional<double>(times.front()));
+    for (std::size_t k = 1; model.Animated && k < times.size(); ++k)
+    {
+      const ResolvedModel at = model.At(times[k]);
+      for (int a = 0; a < 3; ++a)
+      {
+        model.Lo[a] = std::min(model.Lo[a], at.Lo[a]);
+        model.Hi[a] = std::max(model.Hi[a], at.Hi[a]);
+      }
+    }
     if (!this->Bounds.empty())
     {
       ParseBounds(this->Bounds, model.Lo, model.Hi);
@@ -619,7 +632,8 @@ private:
     }
     else
     {
-      const ResolvedModel model = this->ModelToDraw();
+      const ResolvedModel model = this->ModelToDraw(
+        this->TimeOption->count() > 0 ? std::vector<double>{ this->Time } : std::vector<double>{});
       name = model.Name;
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
       ProgressBar bar("rendering " + model.Name, true);
@@ -919,11 +933,15 @@ private:
     }
     else
     {
-      const ResolvedModel model = this->ModelToDraw();
+      // One camera for the whole film: an animated .blob's box holds it at every frame.
+      const ResolvedModel model = this->ModelToDraw(times);
       const render::Camera camera = this->MakeCamera({ model.Lo, model.Hi });
       for (k = 0; k < times.size(); ++k)
       {
-        done(this->DrawModel(model, camera, times[k], show(0, 1)));
+        ResolvedModel frame = k > 0 ? model.At(times[k]) : model;
+        frame.Lo = model.Lo;
+        frame.Hi = model.Hi;
+        done(this->DrawModel(frame, camera, times[k], show(0, 1)));
       }
     }
     const std::string written = output.Commit();

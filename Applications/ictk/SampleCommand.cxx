@@ -53,7 +53,8 @@ public:
     CLI::Option* surface = sample->add_option("--surface", o.Surface,
       "Also extract the surface f = 0 (Flying Edges) into this .vtp, .stl, .ply or .obj");
     CLI::Option* frames = AddFrames(sample, o.Frames,
-      "a space-time model (XYZT, XYT) at every time, as a .pvd series of .vti frames (-o "
+      "a space-time model (XYZT, XYT) or an animated .blob at every time, as a .pvd series of .vti "
+      "frames (-o "
       "name.pvd; the frames go into a folder named after it)");
     CLI::Option* band = sample->add_option("--band", o.Band,
       "With -o name.vdb: keep the points where |f| <= W (in f's units; a distance for a distance "
@@ -81,10 +82,12 @@ public:
       throw UserError(
         "--band: the narrow band is written to a .vdb (-o name.vdb), not '" + o.Output + "'");
     }
-    const GridPlan plan = PlanGrid(o, o.Double ? sizeof(double) : sizeof(float));
+    const std::vector<double> times =
+      o.Frames.empty() ? std::vector<double>{} : ParseFrames(o.Frames);
+    const GridPlan plan = PlanGrid(o, o.Double ? sizeof(double) : sizeof(float), times);
     if (!o.Frames.empty())
     {
-      return runFrames(plan);
+      return runFrames(plan, times);
     }
     if (!o.Surface.empty())
     {
@@ -207,9 +210,8 @@ private:
 
   /// --frames: the grid at every time, written as a .pvd series (issue 16: a 4D field sampled
   /// as a whole, a series of 3D frames).
-  int runFrames(const GridPlan& plan)
+  int runFrames(const GridPlan& plan, const std::vector<double>& times)
   {
-    const std::vector<double> times = ParseFrames(o.Frames);
     if (!HasExtension(o.Output, ".pvd"))
     {
       throw UserError("-o: with --frames the output is a .pvd series, not '" + o.Output + "'");

@@ -221,3 +221,144 @@ TEST(BlobReader, TexturedModelHasMaterialAttributes)
   EXPECT_DOUBLE_EQ(a[0], 0.85);
   EXPECT_DOUBLE_EQ(a[2], 0.15);
 }
+
+// An animated file is a model only at a time: loadModelFile refuses it with its path (never the
+// t = 0 instance), and loadBlobModelFile(path).at(t) is the C++ instantiation at t, as the ictk
+// commands read it with --time (Testing/VTK/blob_check.py checks them against the formula).
+TEST(BlobReader, AnimatedModelFileAtTime)
+{
+  try
+  {
+    lang::loadModelFile(Models + "trex.blob");
+    ADD_FAILURE() << "an animated tree was read without a time";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("trex.blob' is an animated BlobTree"), std::string::npos)
+      << e.what();
+  }
+  const lang::BlobModelFile file = lang::loadBlobModelFile(Models + "trex.blob");
+  EXPECT_TRUE(file.animated());
+  EXPECT_EQ(file.name, "trex");
+  const BlobTree generic = lang::readBlobFile(Models + "trex.blob");
+  for (const double t : { 0.4, 5.0 })
+  {
+    const lang::ModelFile m = file.at(t);
+    const BlobTree instance = generic.instantiate(t);
+    frep::PointEvaluator e(frep::Tape::compile(m.model.geometry().function()));
+    for (const Vec3& p : { Vec3{ 1.5, 0, 3 }, Vec3{ 7.5, 0, 3 }, Vec3{ 4.5, 0.2, 4.4 } })
+    {
+      EXPECT_NEAR(e.eval(p[0], p[1], p[2]), evaluate(instance, p) - instance.threshold(), 1e-12);
+    }
+    const auto box = supportBox(instance);
+    ASSERT_TRUE(m.bounds.has_value());
+    EXPECT_LT((*m.bounds)[0], box[0][0]);
+    EXPECT_GT((*m.bounds)[1], box[1][0]);
+  }
+  // The walk moves the torso: inside at (1.5, 0, 3) at t = 0.4, outside there at t = 5.
+  frep::PointEvaluator a(frep::Tape::compile(file.at(0.4).model.geometry().function()));
+  frep::PointEvaluator b(frep::Tape::compile(file.at(5.0).model.geometry().function()));
+  EXPECT_GT(a.eval(1.5, 0, 3), 0);
+  EXPECT_LT(b.eval(1.5, 0, 3), 0);
+  // pulse.blob by hand: at t = 1 the point is at x = sin(pi / 2) = 1 with R = 2.5, so at
+  // (1.5, 0, 0) q = 0.25 / 6.25 and f = 1 - 22/9 q + 17/9 q^2 - 4/9 q^3 - 1/2.
+  const lang::ModelFile pulse = lang::loadBlobModelFile(Models + "pulse.blob").at(1.0);
+  const double q = 0.04;
+  frep::PointEvaluator c(frep::Tape::compile(pulse.model.geometry().function()));
+  EXPECT_NEAR(
+    c.eval(1.5, 0, 0), 1 - 22.0 / 9 * q + 17.0 / 9 * q * q - 4.0 / 9 * q * q * q - 0.5, 1e-14);
+}
+
+// The new nodes in the file form: a surface of revolution and a solid texture read as built in
+// C++.
+TEST(BlobReader, RevolutionAndSolidTexture)
+{
+  const BlobTree read = lang::readBlob("wood [1 0 0] [0 0 1] 0 0 1 0.5 0 1 {\n"
+                                       "  revolution 1.5 1 2 [0 0 0] [0 0 1] [1 0 0.3] [2 1 0.1] "
+                                       "[1 2 0.3]\n}\n",
+    "r.blob");
+  BlobTree built;
+  const auto r = built.add(
+    Kind::SurfaceOfRevolution, { 1.5, 1, 2, 0, 0, 0, 0, 0, 1, 1, 0, 0.3, 2, 1, 0.1, 1, 2, 0.3 });
+  built.add(Kind::Wood, { 1, 0, 0, 0, 0, 1, 0, 0, 1, 0.5, 0, 1 }, { r });
+  for (const Vec3& p : { Vec3{ 2.4, 0, 1 }, Vec3{ 0.3, 1.7, 0.2 }, Vec3{ -1, 1, 1.5 } })
+  {
+    std::array<double, MaterialSize> a{}, b{};
+    EXPECT_EQ(evaluateTextured(read, p, a), evaluateTextured(built, p, b));
+    EXPECT_EQ(a, b);
+  }
+  EXPECT_EQ(firstError("granite [1 0 0] [0 0 1] 0 0 1 0.5 0 12 { point 1 1 [0 0 0] }\n").line, 1);
+}
+
+// The writer (task: a .blob writer): every bundled model written and read back is the same tree,
+// the same values (angles to an ulp through degrees) and animations, so the same field at every
+// time.
+TEST(BlobReader, WriterRoundTrip)
+{
+  for (const char* name :
+    { "skeletons.blob", "textured.blob", "trex.blob", "pulse.blob", "solid_textures.blob" })
+  {
+    SCOPED_TRACE(name);
+    const BlobTree a = lang::readBlobFile(Models + name);
+    const std::string text = lang::writeBlob(a);
+    const BlobTree b = lang::readBlob(text, "written.blob");
+    ASSERT_EQ(a.nodes().size(), b.nodes().size());
+    EXPECT_EQ(a.threshold(), b.threshold());
+    EXPECT_EQ(a.animated(), b.animated());
+    EXPECT_EQ(a.thresholdAnimation() != nullptr, b.thresholdAnimation() != nullptr);
+    // The reader numbers nodes children first, as the writer lists them: the same order.
+    std::size_t animated = 0;
+    for (std::uint32_t i = 0; i < a.nodes().size(); ++i)
+    {
+      ASSERT_EQ(a.node(i).kind, b.node(i).kind);
+      ASSERT_EQ(a.node(i).valueCount, b.node(i).valueCount);
+      ASSERT_EQ(a.node(i).childCount, b.node(i).childCount);
+      for (std::uint32_t k = 0; k < a.node(i).valueCount; ++k)
+      {
+        const Animation* x = a.animation(i, k);
+        const Animation* y = b.animation(i, k);
+        ASSERT_EQ(x != nullptr, y != nullptr);
+        animated += x != nullptr;
+        if (!x)
+        {
+          EXPECT_NEAR(a.values(i)[k], b.values(i)[k], 1e-15 * std::fabs(a.values(i)[k]));
+          continue;
+        }
+        for (const double t : { -1.0, 0.0, 0.37, 2.5, 7.0, 100.0 })
+        {
+          EXPECT_NEAR(x->eval(t), y->eval(t), 1e-13 * (1 + std::fabs(x->eval(t))));
+        }
+      }
+    }
+    EXPECT_EQ(animated > 0 || a.thresholdAnimation() != nullptr, a.animated());
+    for (const double t : { 0.0, 1.3 })
+    {
+      const BlobTree ia = a.instantiate(t), ib = b.instantiate(t);
+      for (const Vec3& p : { Vec3{ 0.1, 0.2, 0.3 }, Vec3{ 1.5, 0, 3 }, Vec3{ -1.6, 0.4, 0.2 } })
+      {
+        std::array<double, MaterialSize> pa{}, pb{};
+        EXPECT_NEAR(evaluateTextured(ia, p, pa), evaluateTextured(ib, p, pb), 1e-12);
+        for (int m = 0; m < MaterialSize; ++m)
+        {
+          EXPECT_NEAR(pa[m], pb[m], 1e-12);
+        }
+      }
+    }
+  }
+  // Shortest exact numbers, degrees for angles, one node a line.
+  BlobTree t;
+  const auto p = t.add(Kind::Point, { 0.1, 1, 0, 0, 0 });
+  t.add(Kind::Rotate, { 0, 0, 1, M_PI / 2 }, { p });
+  Animation wave;
+  wave.base = 1;
+  wave.amplitude = 0.5;
+  wave.period = 2;
+  t.animate(1, 0, wave);
+  EXPECT_EQ(lang::writeBlob(t),
+    "# A BlobTree (docs/blobtree.md), written by ICTK\n"
+    "threshold 0.5\n"
+    "rotate wave(1 0.5 2 0) 0 1 90 {\n"
+    "  point 0.1 1 0 0 0\n"
+    "}\n");
+  EXPECT_THROW(lang::writeBlob(BlobTree{}), std::invalid_argument);
+}

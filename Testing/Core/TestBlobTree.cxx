@@ -699,3 +699,270 @@ TEST(BlobTree, TextureTreeLoweredAndAsAttributes)
   EXPECT_DOUBLE_EQ(attributes[0], 1.0); // on the segment, away from the disc: pure red
   EXPECT_DOUBLE_EQ(attributes[2], 0.0);
 }
+
+namespace
+{
+// The hash of FRep/SolidTexture.h written out again from its formula, for the tests.
+double fract(double x)
+{
+  return x - std::floor(x);
+}
+double latticeHash(double i, double j, double k)
+{
+  const double a = fract(0.1031 * i), b = fract(0.1031 * j), c = fract(0.1031 * k);
+  const double d = a * (c + 33.33) + b * (b + 33.33) + c * (a + 33.33);
+  return fract((a + d + b + d) * (c + d));
+}
+
+// A ball of radius 2 (R = 4 about the origin) under one solid texture node with colours
+// A = (1, 0, 0) and B = (0, 0, 1), optics (0.1, 0.2, 1.3).
+BlobTree texturedBall(Kind kind, double lambda, double amplitude, int octaves)
+{
+  BlobTree t;
+  const auto p = t.add(Kind::Point, { 4, 1, 0, 0, 0 });
+  t.add(kind, { 1, 0, 0, 0, 0, 1, 0.1, 0.2, 1.3, lambda, amplitude, double(octaves) }, { p });
+  return t;
+}
+
+// s, the pattern, read back from the blue channel (B - A = (-1, 0, 1)), by traversal and by the
+// lowered attribute (which must agree).
+double patternAt(const BlobTree& t, const Vec3& p)
+{
+  std::array<double, MaterialSize> phi{};
+  evaluateTextured(t, p, phi);
+  EXPECT_NEAR(phi[0], 1 - phi[2], 1e-15);
+  EXPECT_EQ(phi[3], 0.1);
+  EXPECT_EQ(phi[5], 1.3);
+  PointEvaluator e(Tape::compile(material(t)[2]));
+  EXPECT_NEAR(e.eval(p[0], p[1], p[2]), phi[2], 1e-12);
+  return phi[2];
+}
+} // namespace
+
+// Procedural solid textures (papers.md 3.5): marble, wood and granite patterns by hand from their
+// formulas, deterministic noise, and the texture moving with a frame node (item 56).
+TEST(BlobTree, SolidTextures)
+{
+  // Marble without turbulence: s = (1 + sin(2 pi x / lambda)) / 2.
+  const BlobTree marble = texturedBall(Kind::Marble, 1.6, 0, 1);
+  EXPECT_NEAR(patternAt(marble, { 0.4, 0.3, -0.2 }), 1.0, 1e-15); // x = lambda / 4: the crest
+  EXPECT_NEAR(patternAt(marble, { 1.2, 0, 0 }), 0.0, 1e-15);      // x = 3 lambda / 4
+  EXPECT_NEAR(patternAt(marble, { 0.2, 1, 1 }), 0.5 + 0.5 * std::sin(M_PI / 4), 1e-15);
+  // Wood without turbulence: rings about z, s = fr(r / lambda), period lambda = 0.5.
+  const BlobTree wood = texturedBall(Kind::Wood, 0.5, 0, 1);
+  EXPECT_NEAR(patternAt(wood, { 0.5, 0, 0.7 }), 0.0, 1e-15);       // r = lambda: a ring starts
+  EXPECT_NEAR(patternAt(wood, { 0.375, 0.5, -0.3 }), 0.25, 1e-15); // r = 0.625 = 1.25 lambda
+  EXPECT_NEAR(patternAt(wood, { 0.6, 0, 0 }), 0.2, 1e-12);
+  for (const double r : { 0.13, 0.37, 0.61 })
+  {
+    EXPECT_NEAR(patternAt(wood, { r, 0, 0.2 }), patternAt(wood, { 0, r + 0.5, 0.2 }), 1e-12);
+    EXPECT_NEAR(patternAt(wood, { r, 0, 0.2 }), patternAt(wood, { r + 1.0, 0, -0.9 }), 1e-12);
+  }
+  // The noise at lattice points is the hash: granite with lambda = 0.5 at p = lambda (i, j, k)
+  // sees noise(i, j, k) = hash(i, j, k) and, one octave up, hash(2i, 2j, 2k).
+  const BlobTree granite1 = texturedBall(Kind::Granite, 0.5, 0, 1);
+  const BlobTree granite2 = texturedBall(Kind::Granite, 0.5, 0, 2);
+  for (const Vec3& ijk : { Vec3{ 1, 2, 3 }, Vec3{ -2, 0, 1 }, Vec3{ 3, -1, -2 } })
+  {
+    const Vec3 p{ 0.5 * ijk[0], 0.5 * ijk[1], 0.5 * ijk[2] };
+    const double h = latticeHash(ijk[0], ijk[1], ijk[2]);
+    EXPECT_NEAR(patternAt(granite1, p), h, 1e-12);
+    EXPECT_NEAR(patternAt(granite2, p),
+      (h + 0.5 * latticeHash(2 * ijk[0], 2 * ijk[1], 2 * ijk[2])) / 1.5, 1e-12);
+  }
+  // Between lattice points, the smooth trilinear mix: at (i + 1/2, j, k), u = 1/2.
+  EXPECT_NEAR(patternAt(granite1, { 0.75, 1, 1.5 }),
+    0.5 * (latticeHash(1, 2, 3) + latticeHash(2, 2, 3)), 1e-12);
+  // The hash's values spread over [0, 1] (not a constant): 1,000 lattice points.
+  double lo = 1, hi = 0, mean = 0;
+  for (int k = 0; k < 1000; ++k)
+  {
+    const double h = latticeHash(k % 10, (k / 10) % 10, k / 100);
+    lo = std::min(lo, h);
+    hi = std::max(hi, h);
+    mean += h / 1000;
+  }
+  EXPECT_LT(lo, 0.02);
+  EXPECT_GT(hi, 0.98);
+  EXPECT_NEAR(mean, 0.5, 0.05);
+  // Marble with turbulence: s = (1 + sin(2 pi (x + a fbm(p / lambda)) / lambda)) / 2 at a
+  // lattice point of p / lambda (lambda = 1, a = 0.3, one octave).
+  const BlobTree veined = texturedBall(Kind::Marble, 1, 0.3, 1);
+  EXPECT_NEAR(patternAt(veined, { 1, -1, 0 }),
+    0.5 + 0.5 * std::sin(2 * M_PI * (1 + 0.3 * latticeHash(1, -1, 0))), 1e-12);
+
+  // Item 56: under a frame node the texture moves with the geometry. Translating the wood by
+  // (0.25, 0, 0) moves its rings' centre there.
+  BlobTree moved;
+  const auto p = moved.add(Kind::Point, { 4, 1, 0, 0, 0 });
+  const auto w = moved.add(Kind::Wood, { 1, 0, 0, 0, 0, 1, 0.1, 0.2, 1.3, 0.5, 0, 1 }, { p });
+  moved.add(Kind::Translate, { 0.25, 0, 0 }, { w });
+  EXPECT_NEAR(patternAt(moved, { 0.85, 0, 0 }), 0.2, 1e-12);      // r = 0.6 from (0.25, 0, 0)
+  EXPECT_NEAR(patternAt(moved, { 0.25, 0.375, 0 }), 0.75, 1e-15); // r = 0.375
+
+  // Bad values are refused with the node's name.
+  BlobTree bad;
+  const auto q = bad.add(Kind::Point, { 1, 1, 0, 0, 0 });
+  EXPECT_THROW(bad.add(Kind::Wood, { 1, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 1 }, { q }),
+    std::invalid_argument); // lambda = 0
+  EXPECT_THROW(bad.add(Kind::Marble, { 1, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0, 9 }, { q }),
+    std::invalid_argument); // 9 octaves
+  EXPECT_THROW(bad.add(Kind::Granite, { 1, 0, 0, 0, -1, 1, 0, 0, 1, 1, 0, 2 }, { q }),
+    std::invalid_argument); // a negative colour
+  // A texture node is neither an operator nor a warp.
+  EXPECT_EQ(moved.operatorCount(), 0u);
+  EXPECT_EQ(moved.warpCount(), 1u);
+}
+
+// Item 50: surfaces of revolution with variable thickness (papers.md 3.4, lines 142-159), with
+// numbers derived by hand in the meridian half-plane (rho, h).
+TEST(BlobTree, SurfaceOfRevolution)
+{
+  const double R = 1.5;
+  // A tube about z: profile (rho, h, t) = (1, 0, 0.2) -> (1, 2, 0.2), one segment. Equal end
+  // radii give the cylinder of line 159: the distance is |rho - 1| - 0.2 between the end tori.
+  BlobTree tube;
+  tube.add(Kind::SurfaceOfRevolution, { R, 1, 1, 0, 0, 0, 0, 0, 1, 1, 0, 0.2, 1, 2, 0.2 });
+  EXPECT_EQ(tube.expand().count(Kind::HollowCone), 1u);
+  for (const double phi : { 0.0, 1.0, 2.5, 4.0 })
+  {
+    const double c = std::cos(phi), s = std::sin(phi);
+    EXPECT_NEAR(evaluate(tube, { 1.1 * c, 1.1 * s, 1 }), 1.0, 1e-12); // in the wall
+    EXPECT_NEAR(evaluate(tube, { 1.5 * c, 1.5 * s, 0.7 }), wyvillByHand(0.3, R), 1e-12);
+    EXPECT_NEAR(evaluate(tube, { 0.5 * c, 0.5 * s, 1.3 }), wyvillByHand(0.3, R), 1e-12);
+    // Below the end: the junction torus of line 155, major radius 1, minor 0.2.
+    EXPECT_NEAR(evaluate(tube, { c, s, -0.5 }), wyvillByHand(0.3, R), 1e-12);
+  }
+  // A bulging profile (1, 0, 0.3), (2, 1, 0.1), (1, 2, 0.3) in n = 2 segments, whose samples are
+  // the control points. The junction at v_1 = (2, 1) is a torus of major radius
+  // distance(v_1, axis) = 2 and minor radius t_1 = 0.1: at (rho, h) = (2.4, 1), beyond both
+  // hollow cones' ends, the distance is 0.4 - 0.1 = 0.3 at every azimuth.
+  BlobTree vase;
+  vase.add(
+    Kind::SurfaceOfRevolution, { R, 1, 2, 0, 0, 0, 0, 0, 1, 1, 0, 0.3, 2, 1, 0.1, 1, 2, 0.3 });
+  const BlobTree pieces = vase.expand();
+  EXPECT_EQ(pieces.count(Kind::HollowCone), 2u);
+  EXPECT_EQ(pieces.count(Kind::Max), 1u);
+  for (const double phi : { 0.3, 2.0, 5.0 })
+  {
+    const double c = std::cos(phi), s = std::sin(phi);
+    EXPECT_NEAR(evaluate(vase, { 2.4 * c, 2.4 * s, 1 }), wyvillByHand(0.3, R), 1e-12);
+    // No bulge (line 114): at the junction, inside both pieces, the max is 1, not their sum 2.
+    EXPECT_DOUBLE_EQ(evaluate(vase, { 2 * c, 2 * s, 1 }), 1.0);
+  }
+  BlobTree summed;
+  {
+    const BlobTree e = vase.expand();
+    std::vector<std::uint32_t> leaves;
+    for (std::uint32_t k = 0; k < e.nodes().size(); ++k)
+    {
+      if (e.node(k).kind == Kind::HollowCone)
+      {
+        const double* v = e.values(k);
+        leaves.push_back(summed.add(Kind::HollowCone, std::vector<double>(v, v + 14)));
+      }
+    }
+    summed.add(Kind::Blend, {}, leaves);
+  }
+  EXPECT_DOUBLE_EQ(evaluate(summed, { 2, 0, 1 }), 2.0);
+  // Level of detail: n segments give n hollow cones under n - 1 max nodes, on an axis that need
+  // not be z (here along (1, 1, 0) through (0.5, 0, 0)); the lowered field agrees with the
+  // traversal everywhere, inside the elements' boxes and outside.
+  BlobTree tilted;
+  tilted.add(Kind::SurfaceOfRevolution,
+    { R, 1, 16, 0.5, 0, 0, 1, 1, 0, 0.5, -1, 0.2, 1.5, 0, 0.05, 0.8, 1, 0.3, 0.2, 2, 0 });
+  const BlobTree lod = tilted.expand();
+  EXPECT_EQ(lod.count(Kind::HollowCone), 16u);
+  EXPECT_EQ(lod.count(Kind::Max), 15u);
+  PointEvaluator e(Tape::compile(potential(tilted)));
+  std::mt19937 rng(50);
+  std::uniform_real_distribution<double> x(-5, 5);
+  int inside = 0;
+  for (int k = 0; k < 1000; ++k)
+  {
+    const Vec3 p{ x(rng), x(rng), x(rng) };
+    const double f = evaluate(tilted, p);
+    inside += f > 0.5;
+    ASSERT_NEAR(e.eval(p[0], p[1], p[2]), f, 1e-12);
+  }
+  EXPECT_GT(inside, 5);
+  // Zero thickness: the plain hollow cone, its surface at distance 0.
+  BlobTree bare;
+  bare.add(Kind::SurfaceOfRevolution, { R, 1, 1, 0, 0, 0, 0, 0, 1, 1, 0, 0, 2, 2, 0 });
+  EXPECT_DOUBLE_EQ(evaluate(bare, { 0, -1.5, 1 }), 1.0); // (rho, h) = (1.5, 1) on the segment
+  // 0.3 along the profile's normal (2, -1) / sqrt 5 from (1.5, 1): the distance is 0.3.
+  const double off = 0.3 / std::sqrt(5.0);
+  EXPECT_NEAR(evaluate(bare, { 1.5 + 2 * off, 0, 1 - off }), wyvillByHand(0.3, R), 1e-12);
+  // Bad values are refused.
+  BlobTree bad;
+  EXPECT_THROW(bad.add(Kind::SurfaceOfRevolution, { R, 1, 1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0 }),
+    std::invalid_argument); // a zero axis
+  EXPECT_THROW(bad.add(Kind::SurfaceOfRevolution, { R, 1, 1, 0, 0, 0, 0, 0, 1, -1, 0, 0, 1, 1, 0 }),
+    std::invalid_argument); // rho < 0
+  EXPECT_THROW(bad.add(Kind::SurfaceOfRevolution, { R, 1, 0, 0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0 }),
+    std::invalid_argument); // no segment
+}
+
+// Item 49: surfaces with variable thickness (papers.md 3.4, lines 127-140), numbers by hand on
+// the triangle (0, 0, 0), (2, 0, 0), (0, 2, 0) with thicknesses 0.2, 0.4, 0.2: its top is the
+// plane through v + t n, z = 0.2 + 0.1 x.
+TEST(BlobTree, SurfaceWithVariableThickness)
+{
+  const double R = 1.5;
+  BlobTree s;
+  s.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0.2, 2, 0, 0, 0.4, 0, 2, 0, 0.2 });
+  const BlobTree e = s.expand();
+  EXPECT_EQ(e.count(Kind::ThickTriangle), 1u);
+  // Over the triangle, d = |h| - t(q): at (0.5, 0.5) the barycentric coordinates are
+  // (0.5, 0.25, 0.25), t = 0.25.
+  EXPECT_NEAR(evaluate(s, { 0.5, 0.5, 0.5 }), wyvillByHand(0.25, R), 1e-12);
+  EXPECT_NEAR(evaluate(s, { 0.5, 0.5, -0.5 }), wyvillByHand(0.25, R), 1e-12);
+  EXPECT_DOUBLE_EQ(evaluate(s, { 0.5, 0.5, 0.1 }), 1.0); // inside the slab
+  EXPECT_DOUBLE_EQ(evaluate(s, { 1, 0.5, 0.3 }), 1.0);   // on the top plane z = 0.2 + 0.1 x
+  EXPECT_NEAR(evaluate(s, { 1, 0.5, 0.8 }), wyvillByHand(0.5, R), 1e-12);
+  // Beyond edge ab: from its nearest point (1, 0, 0), where t = 0.3: d = 0.5 - 0.3.
+  EXPECT_NEAR(evaluate(s, { 1, -0.5, 0 }), wyvillByHand(0.2, R), 1e-12);
+  // Beyond vertex b: d = |p - b| - 0.4.
+  EXPECT_NEAR(evaluate(s, { 2.6, -0.8, 0 }), wyvillByHand(0.6, R), 1e-12);
+  // Null thickness is the triangle element (line 139).
+  BlobTree thin;
+  thin.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0 });
+  EXPECT_EQ(thin.expand().count(Kind::Triangle), 1u);
+  const BlobTree triangle = single(Kind::Triangle, { R, 1, 0, 0, 0, 2, 0, 0, 0, 2, 0 });
+  // Equal thickness, the prism: d = |h| - 0.3 over the triangle.
+  BlobTree prism;
+  prism.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0.3, 2, 0, 0, 0.3, 0, 2, 0, 0.3 });
+  std::mt19937 rng(49);
+  std::uniform_real_distribution<double> x(-1.5, 3);
+  for (int k = 0; k < 300; ++k)
+  {
+    const Vec3 p{ x(rng), x(rng), x(rng) };
+    ASSERT_NEAR(evaluate(thin, p), evaluate(triangle, p), 1e-12);
+    if (p[0] > 0 && p[1] > 0 && p[0] + p[1] < 2)
+    {
+      ASSERT_NEAR(evaluate(prism, p), wyvillByHand(std::max(std::fabs(p[2]) - 0.3, 0.0), R), 1e-12);
+    }
+  }
+  // A folded surface of two triangles sharing the edge (0, 0, 0)-(0, 2, 0): two elements under a
+  // max node, and no crack along the fold: on the shared edge's rounded side both give the same.
+  BlobTree fold;
+  fold.add(Kind::ThickSurface,
+    { R, 1, 0, 0, 0, 0.1, 2, 0, 0, 0.1, 0, 2, 0, 0.1, 0, 0, 0, 0.1, 0, 2, 0, 0.1, -1, 0, 1.5,
+      0.1 });
+  const BlobTree folded = fold.expand();
+  EXPECT_EQ(folded.count(Kind::ThickTriangle), 2u);
+  EXPECT_EQ(folded.count(Kind::Max), 1u);
+  EXPECT_NEAR(evaluate(fold, { -0.3, 1, -0.3 }), wyvillByHand(std::sqrt(0.18) - 0.1, R), 1e-12);
+  // The lowered field agrees with the traversal.
+  PointEvaluator pe(Tape::compile(potential(fold)));
+  for (int k = 0; k < 500; ++k)
+  {
+    const Vec3 p{ x(rng), x(rng), x(rng) };
+    ASSERT_NEAR(pe.eval(p[0], p[1], p[2]), evaluate(fold, p), 1e-12);
+  }
+  BlobTree bad;
+  EXPECT_THROW(bad.add(Kind::ThickSurface, { R, 1, 0, 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0 }),
+    std::invalid_argument); // collinear
+  EXPECT_THROW(bad.add(Kind::ThickSurface, { R, 1, 0, 0, 0, -1, 2, 0, 0, 0, 0, 2, 0, 0 }),
+    std::invalid_argument); // negative thickness
+}

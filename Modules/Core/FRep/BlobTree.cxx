@@ -7,6 +7,7 @@
 // uses them (with the TextureTree's materials) belong together; time and instantiation are in
 // BlobTreeInstance.cxx.
 #include "FRep/BlobTree.h"
+#include "FRep/SolidTexture.h"
 
 #include <algorithm>
 #include <cmath>
@@ -41,6 +42,10 @@ inline double max(double a, double b)
 inline double sqrt(double a)
 {
   return std::sqrt(a);
+}
+inline double abs(double a)
+{
+  return std::fabs(a);
 }
 inline double pow(double a, double b)
 {
@@ -172,6 +177,37 @@ S triangleDistance2(const P<S>& p, const double* a, const double* b, const doubl
   return select(inside, square(dot(minus(p, a), nn)), edges);
 }
 
+// The thick triangle: over the triangle |h| - t(q) with t interpolated by the barycentric
+// coordinates of the foot q; beyond an edge (P, Q) the distance to its nearest point minus the
+// thickness there, the least over the three edges. Both agree on the planes through the edges
+// perpendicular to the triangle, where the regions meet.
+template <class S>
+S thickTriangleDistance(const P<S>& p, const double* v)
+{
+  const double* corner[3] = { v, v + 3, v + 6 };
+  const double t[3] = { v[9], v[10], v[11] };
+  const Vec3 n = vcross(vsub(v + 3, v), vsub(v + 6, v));
+  const double n2 = vdot(n, n);
+  // Edge functions: w_k is the barycentric coordinate of the vertex opposite edge k.
+  S inside(0.0), edges(0.0), thickness(0.0);
+  for (int k = 0; k < 3; ++k)
+  {
+    const double* from = corner[k];
+    const double* to = corner[(k + 1) % 3];
+    const S w = dot(minus(p, from), vcross(n, vsub(to, from))) * (1.0 / n2);
+    thickness = k == 0 ? w * t[2] : thickness + w * t[(k + 2) % 3];
+    inside = k == 0 ? w : min(inside, w);
+    const Vec3 e = vsub(to, from);
+    const S u = min(max(dot(minus(p, from), e) * (1.0 / vdot(e, e)), S(0.0)), S(1.0));
+    const S de = sqrt(square(p.x - from[0] - u * e[0]) + square(p.y - from[1] - u * e[1]) +
+                   square(p.z - from[2] - u * e[2])) -
+      (t[k] + u * (t[(k + 1) % 3] - t[k]));
+    edges = k == 0 ? de : min(edges, de);
+  }
+  const S h = abs(dot(minus(p, v), vscale(n, 1.0 / std::sqrt(n2))));
+  return select(inside, h - thickness, edges);
+}
+
 // Squared distance of an element's skeleton (the values after R and i).
 template <class S>
 S skeletonDistance2(Kind kind, const double* v, std::uint32_t count, const P<S>& p)
@@ -202,6 +238,18 @@ S skeletonDistance2(Kind kind, const double* v, std::uint32_t count, const P<S>&
                        : square(max(sqrt(segmentDistance2(p, v, v + 3)) - v[6], S(0.0)));
     case Kind::ConeSphere:
       return square(max(coneSphereDistance(p, v, v + 3, v[6], v[7]), S(0.0)));
+    case Kind::ThickTriangle:
+      return square(max(thickTriangleDistance(p, v), S(0.0)));
+    case Kind::HollowCone:
+    {
+      // The 2D cone-sphere in the meridian half-plane (rho, h) of the point.
+      const Vec3 n = vscale(vec(v + 3), 1.0 / std::sqrt(vdot(vec(v + 3), vec(v + 3))));
+      const P<S> pc = minus(p, v);
+      const S h = dot(pc, n);
+      const S rho = sqrt(max(norm2(pc) - square(h), S(0.0)));
+      const double a[3] = { v[6], v[7], 0 }, b[3] = { v[9], v[10], 0 };
+      return square(max(coneSphereDistance(P<S>{ rho, h, S(0.0) }, a, b, v[8], v[11]), S(0.0)));
+    }
     default:
       return S(0.0);
   }
@@ -264,6 +312,31 @@ Box elementBox(Kind kind, const double* values, std::uint32_t count)
       grow(b, vec(v), v[6] + R);
       grow(b, vec(v + 3), v[7] + R);
       break;
+    case Kind::ThickTriangle:
+      for (int k = 0; k < 3; ++k)
+      {
+        grow(b, vec(v + 3 * k), std::max({ v[9], v[10], v[11] }) + R);
+      }
+      break;
+    case Kind::HollowCone:
+    {
+      // The cylinder about the axis that holds the revolved profile: its ends' discs of radius r
+      // span r sqrt(1 - n_k^2) along axis k.
+      const Vec3 n = vscale(vec(v + 3), 1.0 / std::sqrt(vdot(vec(v + 3), vec(v + 3))));
+      const double reach = std::max(v[8], v[11]) + R;
+      const double r = std::max(v[6], v[9]) + reach;
+      for (const double h : { std::min(v[7], v[10]) - reach, std::max(v[7], v[10]) + reach })
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          const double centre = v[k] + h * n[k];
+          const double half = r * std::sqrt(std::max(1.0 - n[k] * n[k], 0.0));
+          b[0][k] = std::min(b[0][k], centre - half);
+          b[1][k] = std::max(b[1][k], centre + half);
+        }
+      }
+      break;
+    }
     default:
       for (std::uint32_t k = 0; k + 3 <= count - 2; k += 3)
       {
@@ -481,6 +554,30 @@ struct Walker
         }
         return value(c[0], p, blendBelow, own);
       }
+      case Kind::Marble:
+      case Kind::Wood:
+      case Kind::Granite:
+      {
+        // A solid texture: Phi varies with the point, in this node's frame (FRep/SolidTexture.h).
+        if (!textured)
+        {
+          return child(0, p, blendBelow);
+        }
+        const texture::Pattern pattern = node.kind == Kind::Marble
+          ? texture::Pattern::Marble
+          : (node.kind == Kind::Wood ? texture::Pattern::Wood : texture::Pattern::Granite);
+        const S s = texture::pattern(pattern, p.x, p.y, p.z, v[9], v[10], static_cast<int>(v[11]));
+        std::array<S, MaterialSize> own;
+        for (int m = 0; m < 3; ++m)
+        {
+          own[m] = v[m] + s * (v[m + 3] - v[m]);
+        }
+        for (int m = 3; m < MaterialSize; ++m)
+        {
+          own[m] = S(v[m + 3]);
+        }
+        return value(c[0], p, blendBelow, own);
+      }
       case Kind::Translate:
         return child(0, minus(p, v), blendBelow);
       case Kind::Rotate:
@@ -536,7 +633,11 @@ const Rule& rule(Kind kind)
     { "curve", 2, 3, 2, 0, 0 },
     { "cylinder", 9, 0, 0, 0, 0 },
     { "conesphere", 10, 0, 0, 0, 0 },
+    { "hollowcone", 14, 0, 0, 0, 0 },
+    { "thicktriangle", 14, 0, 0, 0, 0 },
     { "gcylinder", 3, 4, 2, 0, 0 },
+    { "revolution", 9, 3, 2, 0, 0 },
+    { "thicksurface", 2, 12, 1, 0, 0 },
     { "blend", 0, 0, 0, 1, 0 },
     { "hyperblend", 1, 0, 0, 1, 0 },
     { "localblend", 0, 0, 0, 3, 3 },
@@ -545,6 +646,9 @@ const Rule& rule(Kind kind)
     { "difference", 0, 0, 0, 2, 2 },
     { "max", 0, 0, 0, 1, 0 },
     { "material", 6, 0, 0, 1, 1 },
+    { "marble", 12, 0, 0, 1, 1 },
+    { "wood", 12, 0, 0, 1, 1 },
+    { "granite", 12, 0, 0, 1, 1 },
     { "translate", 3, 0, 0, 1, 1 },
     { "rotate", 4, 0, 0, 1, 1 },
     { "scale", 3, 0, 0, 1, 1 },
@@ -584,7 +688,7 @@ void requireNonNegative(Kind kind, const char* name, double v)
 // The geometric checks beyond counts and finiteness.
 void checkValues(Kind kind, const double* v, std::uint32_t count)
 {
-  if (isSkeletal(kind) || kind == Kind::GeneralisedCylinder)
+  if (isSkeletal(kind) || isComplexPrimitive(kind))
   {
     requirePositive(kind, "the radius of influence R", v[0]);
   }
@@ -628,6 +732,62 @@ void checkValues(Kind kind, const double* v, std::uint32_t count)
       }
       break;
     }
+    case Kind::ThickTriangle:
+    {
+      const Vec3 n = vcross(vsub(s + 3, s), vsub(s + 6, s));
+      if (!(vdot(n, n) > 0))
+      {
+        fail(kind, "the three vertices must not be collinear");
+      }
+      for (int k = 9; k < 12; ++k)
+      {
+        requireNonNegative(kind, "every thickness", s[k]);
+      }
+      break;
+    }
+    case Kind::ThickSurface:
+      for (std::uint32_t k = 2; k + 12 <= count; k += 12)
+      {
+        const double* tri = v + k;
+        const Vec3 n = vcross(vsub(tri + 4, tri), vsub(tri + 8, tri));
+        if (!(vdot(n, n) > 0))
+        {
+          fail(kind, "triangle " + std::to_string((k - 2) / 12) + " is degenerate (collinear)");
+        }
+        for (int q = 3; q < 12; q += 4)
+        {
+          requireNonNegative(kind, "every thickness", tri[q]);
+        }
+      }
+      break;
+    case Kind::HollowCone:
+      if (vdot(vec(s + 3), vec(s + 3)) == 0)
+      {
+        fail(kind, "the axis must not be the zero vector");
+      }
+      requireNonNegative(kind, "the distance to the axis rho0", s[6]);
+      requireNonNegative(kind, "the distance to the axis rho1", s[9]);
+      requireNonNegative(kind, "the thickness t0", s[8]);
+      requireNonNegative(kind, "the thickness t1", s[11]);
+      break;
+    case Kind::SurfaceOfRevolution:
+    {
+      if (!(v[2] >= 1 && v[2] <= 100000 && v[2] == std::floor(v[2])))
+      {
+        fail(kind,
+          "the number of segments n must be an integer in [1, 100000] (got " + show(v[2]) + ")");
+      }
+      if (vdot(vec(v + 6), vec(v + 6)) == 0)
+      {
+        fail(kind, "the axis must not be the zero vector");
+      }
+      for (std::uint32_t k = 9; k + 3 <= count; k += 3)
+      {
+        requireNonNegative(kind, "every distance to the axis rho", v[k]);
+        requireNonNegative(kind, "every thickness t", v[k + 2]);
+      }
+      break;
+    }
     case Kind::HyperBlend:
       requirePositive(kind, "the exponent n", v[0]);
       break;
@@ -635,6 +795,21 @@ void checkValues(Kind kind, const double* v, std::uint32_t count)
       for (int k = 0; k < MaterialSize; ++k)
       {
         requireNonNegative(kind, "every material value", v[k]);
+      }
+      break;
+    case Kind::Marble:
+    case Kind::Wood:
+    case Kind::Granite:
+      for (int k = 0; k < 9; ++k)
+      {
+        requireNonNegative(kind, "every colour and optics value", v[k]);
+      }
+      requirePositive(kind, "the period or scale lambda", v[9]);
+      if (!(v[11] >= 1 && v[11] <= texture::MaxOctaves && v[11] == std::floor(v[11])))
+      {
+        fail(kind,
+          "the number of octaves n must be an integer in [1, " +
+            std::to_string(texture::MaxOctaves) + "] (got " + show(v[11]) + ")");
       }
       break;
     case Kind::Rotate:
@@ -667,11 +842,20 @@ const char* kindName(Kind kind)
 }
 bool isSkeletal(Kind kind)
 {
-  return kind <= Kind::ConeSphere;
+  return kind <= Kind::ThickTriangle;
+}
+bool isComplexPrimitive(Kind kind)
+{
+  return kind == Kind::GeneralisedCylinder || kind == Kind::SurfaceOfRevolution ||
+    kind == Kind::ThickSurface;
 }
 bool isWarp(Kind kind)
 {
   return kind >= Kind::Translate;
+}
+bool isTexture(Kind kind)
+{
+  return kind >= Kind::Material && kind <= Kind::Granite;
 }
 bool isBlend(Kind kind)
 {
@@ -821,6 +1005,23 @@ void BlobTree::animate(std::uint32_t node, std::uint32_t index, Animation animat
   animations_.push_back({ nodes_[node].firstValue + index, std::move(animation) });
 }
 
+const Animation* BlobTree::animation(std::uint32_t node, std::uint32_t index) const
+{
+  if (node >= nodes_.size() || index >= nodes_[node].valueCount)
+  {
+    return nullptr;
+  }
+  const std::uint32_t value = nodes_[node].firstValue + index;
+  for (auto a = animations_.rbegin(); a != animations_.rend(); ++a)
+  {
+    if (a->value == value)
+    {
+      return &a->animation;
+    }
+  }
+  return nullptr;
+}
+
 void BlobTree::animateThreshold(Animation animation)
 {
   BlobTree probe;
@@ -875,8 +1076,8 @@ std::size_t BlobTree::operatorCount() const
   visitReachable(*this,
     [&](const Node& node)
     {
-      n += !isSkeletal(node.kind) && !isWarp(node.kind) && node.kind != Kind::GeneralisedCylinder &&
-        node.kind != Kind::Material;
+      n += !isSkeletal(node.kind) && !isWarp(node.kind) && !isComplexPrimitive(node.kind) &&
+        !isTexture(node.kind);
     });
   return n;
 }
@@ -901,7 +1102,7 @@ const BlobTree& expanded(const BlobTree& tree, BlobTree& storage)
 {
   for (const Node& n : tree.nodes())
   {
-    if (n.kind == Kind::GeneralisedCylinder)
+    if (isComplexPrimitive(n.kind))
     {
       tree.instantiate(0.0, storage);
       return storage;

@@ -59,24 +59,56 @@ enum class Kind : std::uint8_t
   Curve,      ///< R i | v0 v1 ...    (a polyline, >= 2 vertices)
   Cylinder,   ///< R i | a b r        (line-swept sphere: the segment thickened by r >= 0)
   ConeSphere, ///< R i | a b r0 r1    (hull of the spheres (a, r0) and (b, r1), r0, r1 >= 0)
-              // --- complex skeletal primitive (expanded into leaves by expand(), papers.md 3.4)
-              // ---
+              /// R i | c n rho0 h0 t0 rho1 h1 t1: a hollow cone of varying thickness
+              /// (papers.md 3.4, line 155), the profile segment from (rho0, h0) to (rho1, h1) (rho
+              /// the distance to the axis through c along n, h the height along it; rho >= 0)
+              /// thickened from t0 to t1 (>= 0) and revolved about the axis. In the meridian
+              /// half-plane it is the 2D cone-sphere, so its ends are the junction tori of line 155
+              /// (major radius rho_i, minor t_i), rho0 = rho1 gives the cylinder of line 159 and t0
+              /// = t1 = 0 the plain hollow cone.
+  HollowCone,
+  /// R i | a b c ta tb tc: a triangle with a thickness at each vertex (>= 0; papers.md 3.4, lines
+  /// 127-140): d = |h| - t(q) over the triangle (h the height, t interpolated at the foot q), and
+  /// |p - q| - t(q) from the nearest point q of an edge beyond it. Its top and bottom are the
+  /// planes through v +- t n; its sides are rounded (the paper's polyhedron has flat sides), so
+  /// that neighbouring triangles of a surface meet without cracks. Null thickness: the triangle.
+  ThickTriangle,
+  // --- complex skeletal primitive (expanded into leaves by expand(), papers.md 3.4)
+  // ---
   GeneralisedCylinder, ///< R i n | (v r)...  (control points with radii, >= 2; n >= 1 segments)
-                       // --- operators ---
-  Blend,               ///< sum of >= 1 children (papers.md 3.3, line 66)
-  HyperBlend,          ///< n | (sum f^n)^(1/n) of >= 1 children, n > 0 (line 70)
-  LocalBlend,          ///< three children A, B, R (line 74), f_R clamped to [0, 1]
-  Union,               ///< >= 1 children (max, or the R-function under a blend: line 92)
-  Intersection,        ///< >= 1 children (min, or the R-function under a blend)
-  Difference,          ///< two children: A \ B = A intersect (2T - f_B) (line 84)
-              /// The max of >= 1 children in every context: the union that joins the pieces of a
-              /// complex primitive (papers.md 3.4, line 114: no bulging). Below a blend, a union
-              /// node becomes the R-function, whose value inside grows by up to (2 + sqrt 2)/(2 -
-              /// sqrt 2) = 5.83 per level (same surface); max keeps deep hierarchies well scaled.
+                       /// R i n c axis | (rho h t)...: a surface of revolution with variable
+                       /// thickness (papers.md 3.4, lines 142-159): a Catmull-Rom profile through
+                       /// the control points (rho >= 0 the distance to the axis through c along
+                       /// `axis`, h the height, t >= 0 the thickness), sampled into n segments (the
+                       /// level of detail), each a HollowCone, joined by max nodes (no bulging).
+  SurfaceOfRevolution,
+  /// R i | (a ta b tb c tc)...: a surface with variable thickness (papers.md 3.4, lines 127-140),
+  /// a triangle mesh given triangle by triangle, each vertex with its thickness: one ThickTriangle
+  /// per triangle (a Triangle where all three thicknesses are null), joined by max nodes.
+  ThickSurface,
+  // --- operators ---
+  Blend,        ///< sum of >= 1 children (papers.md 3.3, line 66)
+  HyperBlend,   ///< n | (sum f^n)^(1/n) of >= 1 children, n > 0 (line 70)
+  LocalBlend,   ///< three children A, B, R (line 74), f_R clamped to [0, 1]
+  Union,        ///< >= 1 children (max, or the R-function under a blend: line 92)
+  Intersection, ///< >= 1 children (min, or the R-function under a blend)
+  Difference,   ///< two children: A \ B = A intersect (2T - f_B) (line 84)
+                /// The max of >= 1 children in every context: the union that joins the pieces of a
+                /// complex primitive (papers.md 3.4, line 114: no bulging). Below a blend, a union
+                /// node becomes the R-function, whose value inside grows by up to (2 + sqrt 2)/(2 -
+                /// sqrt 2) = 5.83 per level (same surface); max keeps deep hierarchies well scaled.
   Max,
   /// r g b rho tau sigma | one child: the material of the subtree (a texture node, papers.md
   /// 3.5, line 165); the field is the child's. Values >= 0.
   Material,
+  /// colourA colourB rho tau sigma lambda a n | one child: a procedural solid texture (papers.md
+  /// 3.5; FRep/SolidTexture.h): the subtree's Phi is ((1 - s) colourA + s colourB, rho, tau,
+  /// sigma) with s the pattern at the point in this node's frame: marble veins across x of
+  /// period lambda, wood rings about z of period lambda, granite speckles of scale lambda; a the
+  /// turbulence amplitude, n its octaves (1..8). Colours and optics >= 0, lambda > 0.
+  Marble,
+  Wood,
+  Granite,
   // --- warps and frame nodes (one child; f_w(A)(p) = f_A(w^-1(p)), line 96) ---
   Translate, ///< t
   Rotate,    ///< axis angle (radians, right-handed, the axis non-zero)
@@ -86,7 +118,11 @@ enum class Kind : std::uint8_t
 
 const char* kindName(Kind kind);
 bool isSkeletal(Kind kind);
+/// Generalised cylinders and surfaces of revolution: expanded into elements by instantiate().
+bool isComplexPrimitive(Kind kind);
 bool isWarp(Kind kind);
+/// Material, marble, wood and granite: the nodes that give their subtree its material Phi.
+bool isTexture(Kind kind);
 /// Blend, hyper-blend and local blend: the nodes below which Booleans become R-functions.
 bool isBlend(Kind kind);
 
@@ -115,6 +151,8 @@ struct Animation
   int order = 2; ///< n: values per key after its time (Keys)
   std::vector<std::vector<double>> keys;
   double eval(double t) const;
+  /// The j-th time derivative at t (j = 0 is eval; 0 for j >= 1 where key-frames are clamped).
+  double derivative(double t, int j) const;
 };
 
 class BlobTree
@@ -147,6 +185,14 @@ public:
     return links_.data() + nodes_[i].firstChild;
   }
   bool animated() const { return !animations_.empty() || thresholdAnimation_.size() == 1; }
+  /// The animation of value `index` of `node` (the last one attached, which instantiate()
+  /// applies), or null for a constant value.
+  const Animation* animation(std::uint32_t node, std::uint32_t index) const;
+  /// The threshold's animation, or null for a constant threshold.
+  const Animation* thresholdAnimation() const
+  {
+    return thresholdAnimation_.empty() ? nullptr : &thresholdAnimation_[0];
+  }
 
   /// Nodes reachable from the root of each kind class.
   std::size_t leafCount() const;
@@ -187,6 +233,7 @@ private:
   std::uint64_t structure_ = 0;               // this structure's number
   std::uint64_t instanceOf_ = 0;              // instantiate(): the structure laid out here
   std::vector<double> tangents_;              // instantiate(): a curve's control tangents
+  std::vector<double> profile_;               // instantiate(): a revolution's profile as curves
 };
 
 /// The paper's field f(p) (>= T inside) as an expression of x, y, z. Booleans follow the context

@@ -58,59 +58,76 @@ std::array<double, 4> curvePoint(
 
 double Animation::eval(double t) const
 {
+  return derivative(t, 0);
+}
+
+double Animation::derivative(double t, int j) const
+{
   if (type == Type::Wave)
   {
-    return base + amplitude * std::sin(2 * pi * t / period + phase);
+    // d^j/dt^j of A sin(w t + phase) is A w^j sin(w t + phase + j pi / 2).
+    const double angle = 2 * pi * t / period + phase;
+    if (j == 0)
+    {
+      return base + amplitude * std::sin(angle);
+    }
+    return amplitude * std::pow(2 * pi / period, j) * std::sin(angle + j * pi / 2);
   }
-  if (keys.size() == 1 || t <= keys.front()[0])
+  // Clamped outside the keys: constant there. At the last key its own derivatives (from the
+  // left); beyond it 0.
+  if (keys.size() == 1 || t < keys.front()[0])
   {
-    return keys.front()[1];
+    return j == 0 ? keys.front()[1] : 0.0;
   }
   if (t >= keys.back()[0])
   {
-    return keys.back()[1];
+    return j == 0 ? keys.back()[1] : (t == keys.back()[0] && j < order ? keys.back()[1 + j] : 0.0);
   }
   std::size_t k = 0;
   while (keys[k + 1][0] <= t)
   {
     ++k;
   }
-  // P(s) = sum c_j s^j on s = (t - t_k) / h, derivatives scaled by h^j: the first n coefficients
+  if (t == keys[k][0] && j < order)
+  {
+    return keys[k][1 + j]; // at a key its own value and derivatives, exactly
+  }
+  // P(s) = sum c_m s^m on s = (t - t_k) / h, derivatives scaled by h^j: the first n coefficients
   // come from the left key, the last n from the right key's conditions (an n x n solve).
   const int n = order;
   const double h = keys[k + 1][0] - keys[k][0];
   std::vector<double> c(2 * n, 0.0);
   double hj = 1, fact = 1;
-  for (int j = 0; j < n; ++j)
+  for (int q = 0; q < n; ++q)
   {
-    c[j] = keys[k][1 + j] * hj / fact;
+    c[q] = keys[k][1 + q] * hj / fact;
     hj *= h;
-    fact *= (j + 1);
+    fact *= (q + 1);
   }
-  // Row j: sum_{m >= n} c_m m!/(m-j)! = v1_j h^j - sum_{m < n} c_m m!/(m-j)!.
+  auto falling = [](int m, int q)
+  {
+    double f = 1;
+    for (int r = 0; r < q; ++r)
+    {
+      f *= (m - r);
+    }
+    return f;
+  };
+  // Row q: sum_{m >= n} c_m m!/(m-q)! = v1_q h^q - sum_{m < n} c_m m!/(m-q)!.
   std::vector<double> A(n * n), rhs(n);
   hj = 1;
-  for (int j = 0; j < n; ++j)
+  for (int q = 0; q < n; ++q)
   {
-    auto falling = [](int m, int j2)
-    {
-      double f = 1;
-      for (int q = 0; q < j2; ++q)
-      {
-        f *= (m - q);
-      }
-      return f;
-    };
-    double r = keys[k + 1][1 + j] * hj;
+    double r = keys[k + 1][1 + q] * hj;
     for (int m = 0; m < n; ++m)
     {
-      r -= c[m] * (m >= j ? falling(m, j) : 0.0);
+      r -= c[m] * (m >= q ? falling(m, q) : 0.0);
     }
     for (int m = n; m < 2 * n; ++m)
     {
-      A[j * n + (m - n)] = falling(m, j);
+      A[q * n + (m - n)] = falling(m, q);
     }
-    rhs[j] = r;
+    rhs[q] = r;
     hj *= h;
   }
   for (int col = 0; col < n; ++col) // Gaussian elimination with partial pivoting
@@ -147,13 +164,14 @@ double Animation::eval(double t) const
     }
     c[n + r] = v / A[r * n + r];
   }
+  // The j-th derivative: sum_{m >= j} c_m m!/(m-j)! s^(m-j), divided by h^j.
   const double s = (t - keys[k][0]) / h;
   double value = 0;
-  for (int j = 2 * n - 1; j >= 0; --j)
+  for (int m = 2 * n - 1; m >= j; --m)
   {
-    value = value * s + c[j];
+    value = value * s + c[m] * falling(m, j);
   }
-  return value;
+  return j == 0 ? value : value / std::pow(h, j);
 }
 
 namespace
@@ -186,6 +204,18 @@ Kind cylinderPiece(const double* nv, const std::array<double, 4>& a, const std::
   count = b[3] == 0 ? 8 : 9;
   return b[3] == 0 ? Kind::Segment : Kind::Cylinder;
 }
+
+// A surface of revolution's element between two profile samples (rho, h, 0, t): a HollowCone
+// about the primitive's axis (values R i n c axis ...), rho kept >= 0 where the spline overshoots.
+Kind revolutionPiece(const double* nv, const std::array<double, 4>& a,
+  const std::array<double, 4>& b, double* out, std::uint32_t& count)
+{
+  const double values[14] = { nv[0], nv[1], nv[3], nv[4], nv[5], nv[6], nv[7], nv[8],
+    std::max(a[0], 0.0), a[1], a[3], std::max(b[0], 0.0), b[1], b[3] };
+  std::copy(values, values + 14, out);
+  count = 14;
+  return Kind::HollowCone;
+}
 } // namespace
 
 void BlobTree::touch()
@@ -193,6 +223,31 @@ void BlobTree::touch()
   structure_ = ++structures;
   instanceOf_ = 0;
 }
+
+namespace
+{
+// A balanced tree of binary max nodes over the pieces (line 114: the union, no bulging; line
+// 125: a hierarchy that follows the pieces' order, so spatial neighbours share subtrees).
+template <class Push>
+std::uint32_t joinUnderMax(
+  std::vector<std::uint32_t>& level, std::vector<std::uint32_t>& next, Push& push)
+{
+  while (level.size() > 1)
+  {
+    next.clear();
+    for (std::size_t k = 0; k + 1 < level.size(); k += 2)
+    {
+      next.push_back(push(Kind::Max, nullptr, 0, 0, &level[k], 2));
+    }
+    if (level.size() % 2)
+    {
+      next.push_back(level.back());
+    }
+    level.swap(next);
+  }
+  return level[0];
+}
+} // namespace
 
 void BlobTree::instantiate(double t, BlobTree& out) const
 {
@@ -241,7 +296,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
   {
     const Node& n = nodes_[i];
     const double* nv = v.data() + n.firstValue;
-    if (n.kind != Kind::GeneralisedCylinder)
+    if (!isComplexPrimitive(n.kind))
     {
       if (!relayout)
       {
@@ -260,23 +315,77 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     // cone-sphere where the end radii differ, a line-swept sphere where they are equal, a
     // segment where both are null, under a balanced tree of binary unions (max: Kind::Max). Each
     // element has a slot of 10 values, so that a kind changing with t keeps the layout.
+    //
+    // Surface of revolution (lines 150-159): the profile (rho, h, t) sampled the same way, each
+    // segment a HollowCone (its ends are the junction tori), under the same union tree.
+    if (n.kind == Kind::ThickSurface)
+    {
+      // Surface with variable thickness (lines 127-140): a thick triangle per triangle, a plain
+      // triangle where its three thicknesses are null (line 139), in slots of 14 values.
+      level.clear();
+      for (std::uint32_t k = 2; k + 12 <= n.valueCount; k += 12)
+      {
+        const double* tri = nv + k;
+        const bool thin = tri[3] == 0 && tri[7] == 0 && tri[11] == 0;
+        const double pieceValues[14] = { nv[0], nv[1], tri[0], tri[1], tri[2], tri[4], tri[5],
+          tri[6], tri[8], tri[9], tri[10], tri[3], tri[7], tri[11] };
+        const Kind kind = thin ? Kind::Triangle : Kind::ThickTriangle;
+        const std::uint32_t count = thin ? 11 : 14;
+        if (relayout)
+        {
+          level.push_back(push(kind, pieceValues, count, 14, nullptr, 0));
+          out.pieces_.push_back(level.back());
+        }
+        else
+        {
+          Node& leaf = out.nodes_[out.pieces_[piece++]];
+          leaf.kind = kind;
+          leaf.valueCount = count;
+          std::copy(pieceValues, pieceValues + 14, out.values_.data() + leaf.firstValue);
+        }
+      }
+      if (relayout)
+      {
+        map[i] = joinUnderMax(level, next, push);
+      }
+      continue;
+    }
+    const bool revolution = n.kind == Kind::SurfaceOfRevolution;
     const auto segments = static_cast<std::uint32_t>(nv[2]);
-    const std::uint32_t controls = (n.valueCount - 3) / 4;
+    const double* ctrl = nv + 3;
+    std::uint32_t controls = (n.valueCount - 3) / 4;
+    if (revolution)
+    {
+      // The profile as (rho, h, 0, t), the layout of the curve code.
+      controls = (n.valueCount - 9) / 3;
+      std::vector<double>& profile = out.profile_;
+      profile.resize(4 * controls);
+      for (std::uint32_t k = 0; k < controls; ++k)
+      {
+        profile[4 * k] = nv[9 + 3 * k];
+        profile[4 * k + 1] = nv[10 + 3 * k];
+        profile[4 * k + 2] = 0;
+        profile[4 * k + 3] = nv[11 + 3 * k];
+      }
+      ctrl = profile.data();
+    }
+    const std::uint32_t slot = revolution ? 14 : 10;
     std::vector<double>& tangents = out.tangents_;
     tangents.resize(4 * controls);
-    curveTangents(nv + 3, controls, tangents.data());
-    std::array<double, 4> prev = curvePoint(nv + 3, tangents.data(), controls, 0.0);
+    curveTangents(ctrl, controls, tangents.data());
+    std::array<double, 4> prev = curvePoint(ctrl, tangents.data(), controls, 0.0);
     level.clear();
     for (std::uint32_t s = 1; s <= segments; ++s)
     {
-      const std::array<double, 4> cur = curvePoint(nv + 3, tangents.data(), controls,
+      const std::array<double, 4> cur = curvePoint(ctrl, tangents.data(), controls,
         static_cast<double>(controls - 1) * s / static_cast<double>(segments));
-      double pieceValues[10];
+      double pieceValues[14];
       std::uint32_t count = 0;
-      const Kind kind = cylinderPiece(nv, prev, cur, pieceValues, count);
+      const Kind kind = revolution ? revolutionPiece(nv, prev, cur, pieceValues, count)
+                                   : cylinderPiece(nv, prev, cur, pieceValues, count);
       if (relayout)
       {
-        level.push_back(push(kind, pieceValues, count, 10, nullptr, 0));
+        level.push_back(push(kind, pieceValues, count, slot, nullptr, 0));
         out.pieces_.push_back(level.back());
       }
       else
@@ -284,7 +393,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
         Node& leaf = out.nodes_[out.pieces_[piece++]];
         leaf.kind = kind;
         leaf.valueCount = count;
-        std::copy(pieceValues, pieceValues + 10, out.values_.data() + leaf.firstValue);
+        std::copy(pieceValues, pieceValues + slot, out.values_.data() + leaf.firstValue);
       }
       prev = cur;
     }
@@ -292,20 +401,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     {
       continue;
     }
-    while (level.size() > 1)
-    {
-      next.clear();
-      for (std::size_t k = 0; k + 1 < level.size(); k += 2)
-      {
-        next.push_back(push(Kind::Max, nullptr, 0, 0, &level[k], 2));
-      }
-      if (level.size() % 2)
-      {
-        next.push_back(level.back());
-      }
-      level.swap(next);
-    }
-    map[i] = level[0];
+    map[i] = joinUnderMax(level, next, push);
   }
   out.root_ = map[root_];
   out.instanceOf_ = structure_;

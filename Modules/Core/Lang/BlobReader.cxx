@@ -5,6 +5,7 @@
 #include "Lang/BlobReader.h"
 
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -463,10 +464,20 @@ private:
     {
       elements = (values.size() - 5) / 3;
     }
-    if (*kind == Kind::GeneralisedCylinder && values.size() >= 3 && values[2] >= 1 &&
-      values[2] <= 100000)
+    if (frep::blob::isComplexPrimitive(*kind) && *kind != Kind::ThickSurface &&
+      values.size() >= 3 && values[2] >= 1 && values[2] <= 100000)
     {
       elements = static_cast<std::size_t>(values[2]);
+    }
+    if (*kind == Kind::ThickSurface && values.size() >= 2)
+    {
+      elements = (values.size() - 2) / 12; // a triangle each
+    }
+    // A solid texture's noise lowers to some 150 expression nodes an octave.
+    if (frep::blob::isTexture(*kind) && *kind != Kind::Material && values.size() == 12 &&
+      values[11] >= 1 && values[11] <= 8)
+    {
+      elements = 1 + 3 * static_cast<std::size_t>(values[11]);
     }
     expandedLeaves_ += elements;
     if (expandedLeaves_ * 64 > limits_.maxExpressionNodes)
@@ -535,6 +546,106 @@ frep::blob::BlobTree readBlob(
 frep::blob::BlobTree readBlobFile(const std::string& path, const Limits& limits)
 {
   return readBlob(readSourceFile(path, limits), path, limits);
+}
+
+namespace
+{
+// The shortest decimal form that reads back to the same double.
+void appendNumber(std::string& out, double v)
+{
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
+  out.append(buffer, result.ptr);
+}
+
+// Rotate's angle and twist's rate are degrees in the file (the reader's conversion, undone).
+bool isAngle(Kind kind, std::uint32_t slot)
+{
+  return (kind == Kind::Rotate && slot == 3) || (kind == Kind::Twist && slot == 0);
+}
+
+void appendAnimation(std::string& out, const Animation& a, double scale)
+{
+  if (a.type == Animation::Type::Wave)
+  {
+    out += "wave(";
+    appendNumber(out, a.base * scale);
+    out += ' ';
+    appendNumber(out, a.amplitude * scale);
+    out += ' ';
+    appendNumber(out, a.period);
+    out += ' ';
+    appendNumber(out, a.phase); // radians, as read
+    out += ')';
+    return;
+  }
+  out += "keys(" + std::to_string(a.order);
+  for (const auto& key : a.keys)
+  {
+    out += ',';
+    for (std::size_t k = 0; k < key.size(); ++k)
+    {
+      out += ' ';
+      appendNumber(out, k == 0 ? key[k] : key[k] * scale); // the time is not an angle
+    }
+  }
+  out += ')';
+}
+
+void appendNode(std::string& out, const frep::blob::BlobTree& tree, std::uint32_t index, int depth)
+{
+  constexpr double toDegrees = 180.0 / 3.14159265358979323846;
+  const frep::blob::Node& node = tree.node(index);
+  out.append(2 * static_cast<std::size_t>(depth), ' ');
+  out += frep::blob::kindName(node.kind);
+  const double* values = tree.values(index);
+  for (std::uint32_t k = 0; k < node.valueCount; ++k)
+  {
+    out += ' ';
+    const double scale = isAngle(node.kind, k) ? toDegrees : 1.0;
+    if (const Animation* a = tree.animation(index, k))
+    {
+      appendAnimation(out, *a, scale);
+    }
+    else
+    {
+      appendNumber(out, values[k] * scale);
+    }
+  }
+  if (node.childCount == 0)
+  {
+    out += '\n';
+    return;
+  }
+  out += " {\n";
+  const std::uint32_t* children = tree.children(index);
+  for (std::uint32_t k = 0; k < node.childCount; ++k)
+  {
+    appendNode(out, tree, children[k], depth + 1);
+  }
+  out.append(2 * static_cast<std::size_t>(depth), ' ');
+  out += "}\n";
+}
+} // namespace
+
+std::string writeBlob(const frep::blob::BlobTree& tree)
+{
+  if (tree.empty())
+  {
+    throw std::invalid_argument("writeBlob: the tree is empty");
+  }
+  std::string out = "# A BlobTree (docs/blobtree.md), written by ICTK\nthreshold ";
+  if (const Animation* a = tree.thresholdAnimation())
+  {
+    appendAnimation(out, *a, 1.0);
+  }
+  else
+  {
+    appendNumber(out, tree.threshold());
+  }
+  out += '\n';
+  appendNode(out, tree, tree.root(), 0);
+  return out;
 }
 
 } // namespace ictk::lang

@@ -31,4 +31,12 @@ frep::blob::BlobTree readBlob(
 /// Reads and parses a file. Throws ParseError (also for an unreadable or too large file).
 frep::blob::BlobTree readBlobFile(const std::string& path, const Limits& limits = {});
 
+/// The .blob text of a generic tree: the threshold, then the nodes reachable from the root, one
+/// a line, indented by depth, with their animations as wave(...) and keys(...) and their angles
+/// in degrees. readBlob reads it back to the same tree: the same nodes, values and animations
+/// (bit for bit, but for angles, which go through degrees and back to within an ulp). Numbers
+/// are written in their shortest form that reads back exactly. Throws std::invalid_argument for
+/// an empty tree.
+std::string writeBlob(const frep::blob::BlobTree& tree);
+
 } // namespace ictk::lang

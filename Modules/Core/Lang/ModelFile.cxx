@@ -181,6 +181,44 @@ bool isModelFile(const std::string& path)
   return formatOf(path) != Format::Unknown;
 }
 
+bool isBlobFile(const std::string& path)
+{
+  return formatOf(path) == Format::Blob;
+}
+
+BlobModelFile loadBlobModelFile(const std::string& path, const Limits& limits)
+{
+  return BlobModelFile{ std::filesystem::path(path).stem().string(), readBlobFile(path, limits) };
+}
+
+ModelFile BlobModelFile::at(double t) const
+{
+  // The tree's field mapped to f >= 0 inside (frep::blob::shape); the bounds are the instance's
+  // support box, where every element's field vanishes, with a 2 % margin.
+  const frep::blob::BlobTree instance = tree.instantiate(t);
+  const auto box = frep::blob::supportBox(instance);
+  std::array<double, 6> bounds{};
+  for (int a = 0; a < 3; ++a)
+  {
+    const double pad = 0.02 * (box[1][a] - box[0][a]);
+    bounds[2 * a] = box[0][a] - pad;
+    bounds[2 * a + 1] = box[1][a] + pad;
+  }
+  // Texture nodes (material, marble, wood, granite) make a TextureTree: its colour and optics
+  // become the model's attributes.
+  bool textured = false;
+  for (const frep::blob::Node& n : instance.nodes())
+  {
+    textured = textured || frep::blob::isTexture(n.kind);
+  }
+  if (textured)
+  {
+    return ModelFile{ name, 0, frep::blob::texturedHypervolume(instance), bounds };
+  }
+  return ModelFile{ name, 0, frep::Hypervolume(frep::blob::shape(instance).withLabel(name)),
+    bounds };
+}
+
 bool isSceneFile(const std::string& path)
 {
   return formatOf(path) == Format::Scene;
@@ -214,34 +252,17 @@ ModelFile loadModelFile(
     }
     case Format::Blob:
     {
-      // A static BlobTree, its field mapped to f >= 0 inside (frep::blob::shape); the bounds
-      // are its support box, where every element's field vanishes, with a 2 % margin. A model
-      // file has no time to instantiate an animated tree at, and its t = 0 instance would be
-      // a silent answer to a question about another time: refused.
-      const frep::blob::BlobTree generic = readBlobFile(path, limits);
-      if (generic.animated())
+      // A model file read without a time has no instant to instantiate an animated tree at, and
+      // its t = 0 instance would be a silent answer to a question about another time: refused.
+      const BlobModelFile blob = loadBlobModelFile(path, limits);
+      if (blob.animated())
       {
         throw std::invalid_argument("'" + path +
-          "' is an animated BlobTree: the ictk commands read static trees only (instantiate it "
-          "at a time t with frep::blob::BlobTree::instantiate(t); docs/blobtree.md)");
+          "' is an animated BlobTree: it is a model only at a time t (`ictk eval`, `sample`, "
+          "`mesh` and `render` instantiate it with --time t or --frames T0:T1:DT; in C++, "
+          "lang::loadBlobModelFile(path).at(t); docs/blobtree.md)");
       }
-      const frep::blob::BlobTree tree = generic.instantiate(0.0);
-      std::string name = std::filesystem::path(path).stem().string();
-      const auto box = frep::blob::supportBox(tree);
-      std::array<double, 6> bounds{};
-      for (int a = 0; a < 3; ++a)
-      {
-        const double pad = 0.02 * (box[1][a] - box[0][a]);
-        bounds[2 * a] = box[0][a] - pad;
-        bounds[2 * a + 1] = box[1][a] + pad;
-      }
-      // Material nodes make a TextureTree: its colour and optics become the model's attributes.
-      if (tree.count(frep::blob::Kind::Material) > 0)
-      {
-        return ModelFile{ name, 0, frep::blob::texturedHypervolume(tree), bounds };
-      }
-      return ModelFile{ name, 0, frep::Hypervolume(frep::blob::shape(tree).withLabel(name)),
-        bounds };
+      return blob.at(0.0);
     }
     case Format::Xml:
     {

@@ -5,6 +5,7 @@
 // (saveSceneFile); .vm (Fidget's SSA benchmark format, negated on import) and .blob (a BlobTree,
 // mapped to f >= 0 inside by frep::blob::shape) are read only.
 
+#include "FRep/BlobTree.h"
 #include "FRep/Hypervolume.h"
 #include "Lang/Diagnostics.h"
 
@@ -25,14 +26,34 @@ struct ModelFile
   std::optional<std::array<double, 6>> bounds;
 };
 
+/// A .blob file read once (docs/blobtree.md). An animated tree (key-frames, waves, an animated
+/// threshold) changes with time outside its domain: it is a model only at a time t, its instance
+/// (BlobTree::instantiate). A static tree is the same model at every t.
+struct BlobModelFile
+{
+  std::string name;
+  frep::blob::BlobTree tree; ///< the generic tree, as read
+  bool animated() const { return tree.animated(); }
+  /// The model at time t: the instance's shape (potential - T; with its materials as the
+  /// attributes "colour" and "optics" when the tree has material nodes) and its support box at t
+  /// with a 2 % margin as the bounds.
+  ModelFile at(double t) const;
+};
+/// Reads a .blob file; throws ParseError (diagnostics name the file).
+BlobModelFile loadBlobModelFile(const std::string& path, const Limits& limits = {});
+
+/// True for paths ending in .blob (case-insensitive).
+bool isBlobFile(const std::string& path);
 /// True for paths ending in .hf, .xml, .scn, .scene, .vm or .blob (case-insensitive).
 bool isModelFile(const std::string& path);
 /// True for paths ending in .scn or .scene (case-insensitive): seed 003's scenes (Lang/Scene.h).
 bool isSceneFile(const std::string& path);
-/// Opens a .hf, .xml, .scn or .vm file; throws ParseError (diagnostics name the file) or
+/// Opens a .hf, .xml, .scn, .vm or .blob file; throws ParseError (diagnostics name the file) or
 /// std::invalid_argument for an unknown extension. `parameterValues` specialises a HyperFun model
 /// (see readHyperFun); an XML model keeps its parameter slots. A scene is its built hypervolume
-/// (lang::buildScene: the attributes "object", "colour", "perturbation").
+/// (lang::buildScene: the attributes "object", "colour", "perturbation"). A static .blob is its
+/// tree's model (BlobModelFile::at); an animated one has no model without a time and is refused
+/// (std::invalid_argument naming the file): read it with loadBlobModelFile and instantiate it.
 ModelFile loadModelFile(const std::string& path, const Limits& limits = {},
   const std::vector<double>& parameterValues = {});
 /// A box {xmin, xmax, ymin, ymax, zmin, zmax} that holds the model: the file's own bounds when it

@@ -49,6 +49,20 @@ struct Plan
 struct ictkFRepSampler::Internals
 {
   ictkFRepModel Model;
+  /// SetHypervolumeOfTime(): in use while Model.Explicit is its instance at InstanceTime
+  /// (setting a name, file or hypervolume clears Explicit or this).
+  std::function<frep::Hypervolume(double)> OfTime;
+  double InstanceTime = 0;
+  bool OfTimeInUse() const { return this->OfTime && this->Model.Explicit; }
+  /// Model.Explicit made the instance at t.
+  void Instantiate(double t)
+  {
+    if (this->InstanceTime != t)
+    {
+      this->Model.Explicit = std::make_unique<frep::Hypervolume>(this->OfTime(t));
+      this->InstanceTime = t;
+    }
+  }
 
   bool MakePlan(ictkFRepSampler* self, Plan& plan, std::string& error);
 };
@@ -156,6 +170,16 @@ void ictkFRepSampler::SetModelName(const char* name)
 void ictkFRepSampler::SetHypervolume(const frep::Hypervolume& hv)
 {
   this->Internal->Model.Explicit = std::make_unique<frep::Hypervolume>(hv);
+  this->Internal->OfTime = nullptr;
+  this->Modified();
+}
+
+void ictkFRepSampler::SetHypervolumeOfTime(std::function<frep::Hypervolume(double)> model)
+{
+  Internals& in = *this->Internal;
+  in.OfTime = std::move(model);
+  in.Model.Explicit = std::make_unique<frep::Hypervolume>(in.OfTime(this->Time));
+  in.InstanceTime = this->Time;
   this->Modified();
 }
 
@@ -261,7 +285,7 @@ bool ictkFRepSampler::Internals::MakePlan(ictkFRepSampler* self, Plan& plan, std
     resolution[a] = hi[a] > lo[a] ? dims[a] : std::min(dims[a], 1);
   }
   plan.grid = frep::gridOverBox(lo, hi, resolution, self->GetTime());
-  plan.timeDependent =
+  plan.timeDependent = internal.OfTimeInUse() ||
     (frep::domainAxes(plan.hv->geometry().domain()) & (1u << static_cast<int>(frep::Axis::T))) != 0;
 
   const int type = self->GetOutputScalarType();
@@ -428,6 +452,11 @@ int ictkFRepSampler::RequestData(
       vtkErrorMacro(<< "the requested time is not a finite number");
       return 0;
     }
+  }
+  if (this->Internal->OfTimeInUse())
+  {
+    this->Internal->Instantiate(plan.grid.time);
+    plan.hv = this->Internal->Model.Explicit.get();
   }
   if (plan.timeDependent)
   {

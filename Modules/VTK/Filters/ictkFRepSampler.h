@@ -41,8 +41,9 @@
 #include "ictkFiltersFRepModule.h" // export macro
 #include "vtkImageAlgorithm.h"
 
-#include <memory> // for std::unique_ptr
-#include <vector> // for std::vector
+#include <functional> // for std::function
+#include <memory>     // for std::unique_ptr
+#include <vector>     // for std::vector
 
 #ifndef __VTK_WRAP__
 namespace ictk
@@ -85,6 +86,13 @@ public:
    * Samples `hv` (copied) instead of a registered model. ModelBounds must be set.
    */
   void SetHypervolume(const ictk::frep::Hypervolume& hv);
+  /**
+   * A model that changes with time outside its domain (an animated BlobTree, whose instance at t
+   * is an XYZ model): `model(t)` is sampled at the time of each request, and the output is
+   * time-dependent as for an XYZT model. Replaces a model name, file or hypervolume (until one of
+   * them is set again). ModelBounds must be set.
+   */
+  void SetHypervolumeOfTime(std::function<ictk::frep::Hypervolume(double)> model);
   /**
    * Values of the model's parameters (Expr::parameter slots), default none.
    */
