@@ -62,17 +62,68 @@ struct StudySettings
   double compression = 0;
 };
 
+/// A study object's keys must be ones docs/medical.md lists: a misspelt "modulus_lwa" would
+/// otherwise leave the default law in force without a word.
+void checkObject(const Json& j, std::initializer_list<const char*> known, const std::string& where)
+{
+  if (!j.is_object())
+  {
+    throw UserError(where + " must be a JSON object");
+  }
+  for (const auto& item : j.items())
+  {
+    if (std::none_of(known.begin(), known.end(), [&](const char* k) { return item.key() == k; }))
+    {
+      std::string list;
+      for (const char* k : known)
+      {
+        list += (list.empty() ? "\"" : ", \"") + std::string(k) + "\"";
+      }
+      throw UserError(where + ": unknown key \"" + item.key() + "\" (known: " + list + ")");
+    }
+  }
+}
+
 double numberAt(const Json& j, const char* key, double fallback, const std::string& where)
 {
   if (!j.contains(key))
   {
     return fallback;
   }
-  if (!j[key].is_number())
+  if (!j[key].is_number() || !std::isfinite(j[key].get<double>()))
   {
     throw UserError(where + ": \"" + key + "\" must be a number");
   }
   return j[key].get<double>();
+}
+
+std::string stringAt(const Json& j, const char* key, const std::string& where)
+{
+  if (!j.contains(key))
+  {
+    return {};
+  }
+  if (!j[key].is_string())
+  {
+    throw UserError(where + ": \"" + key + "\" must be a string (a cell's name)");
+  }
+  return j[key].get<std::string>();
+}
+
+std::vector<std::string> stringsAt(
+  const Json& j, const char* key, std::vector<std::string> fallback, const std::string& where)
+{
+  if (!j.contains(key))
+  {
+    return fallback;
+  }
+  const Json& list = j[key];
+  if (!list.is_array() ||
+    !std::all_of(list.begin(), list.end(), [](const Json& e) { return e.is_string(); }))
+  {
+    throw UserError(where + ": \"" + key + "\" must be a list of cell names");
+  }
+  return list.get<std::vector<std::string>>();
 }
 
 StudySettings readSettings(const std::string& path)
@@ -97,34 +148,76 @@ StudySettings readSettings(const std::string& path)
     throw UserError("'" + path + "' has no \"study\" object (docs/medical.md)");
   }
   const Json& s = doc["study"];
+  checkObject(s,
+    { "size", "scan", "scan_cells", "implants", "density_law", "modulus_law", "sampling",
+      "bin_width", "poisson_ratio", "minimum_modulus", "fixed", "solve" },
+    where);
   StudySettings out;
   out.size = numberAt(s, "size", 1, where);
-  out.scan = s.value("scan", std::string());
-  const auto cells = doc.value("cells", Json::array());
-  if (std::none_of(cells.begin(), cells.end(),
-        [&](const Json& cell)
+  if (!(out.size > 0))
+  {
+    throw UserError(where + ": \"size\" must be a positive element size (mm)");
+  }
+  out.scan = stringAt(s, "scan", where);
+  std::vector<std::string> cellNames;
+  if (doc.contains("cells") && doc["cells"].is_array())
+  {
+    for (const Json& cell : doc["cells"])
+    {
+      if (cell.is_object() && cell.contains("name") && cell["name"].is_string())
+      {
+        cellNames.push_back(cell["name"].get<std::string>());
+        if (cellNames.back() == out.scan && cell.value("kind", Json()) != "V")
         {
-          return cell.value("name", std::string()) == out.scan &&
-            cell.value("kind", std::string()) == "V";
-        }))
+          cellNames.back().clear(); // not a voxel cell: cannot be the scan
+        }
+      }
+    }
+  }
+  const auto isCell = [&](const std::string& name)
+  {
+    return !name.empty() &&
+      std::find(cellNames.begin(), cellNames.end(), name) != cellNames.end();
+  };
+  if (!isCell(out.scan))
   {
     throw UserError(where + ": \"scan\" must name a voxel (V) cell of the complex");
   }
-  out.implants = s.value("implants", std::vector<std::string>());
+  const auto namesCells = [&](const std::vector<std::string>& names, const char* key)
+  {
+    for (const std::string& name : names)
+    {
+      if (!isCell(name) && name != out.scan)
+      {
+        throw UserError(
+          where + ": \"" + key + "\" names '" + name + "', which is not a cell of the complex");
+      }
+    }
+  };
+  out.implants = stringsAt(s, "implants", {}, where);
+  namesCells(out.implants, "implants");
   auto& m = out.materials;
-  const std::vector<std::string> scanCells =
-    s.value("scan_cells", std::vector<std::string>{ out.scan });
+  const std::vector<std::string> scanCells = stringsAt(s, "scan_cells", { out.scan }, where);
+  namesCells(scanCells, "scan_cells");
   m.scanCells.insert(scanCells.begin(), scanCells.end());
   if (s.contains("density_law"))
   {
-    m.density.a = numberAt(s["density_law"], "a", m.density.a, where + ".density_law");
-    m.density.b = numberAt(s["density_law"], "b", m.density.b, where + ".density_law");
+    const Json& law = s["density_law"];
+    checkObject(law, { "a", "b" }, where + ".density_law");
+    m.density.a = numberAt(law, "a", m.density.a, where + ".density_law");
+    m.density.b = numberAt(law, "b", m.density.b, where + ".density_law");
   }
   if (s.contains("modulus_law"))
   {
-    m.modulus.a = numberAt(s["modulus_law"], "a", m.modulus.a, where + ".modulus_law");
-    m.modulus.b = numberAt(s["modulus_law"], "b", m.modulus.b, where + ".modulus_law");
-    m.modulus.c = numberAt(s["modulus_law"], "c", m.modulus.c, where + ".modulus_law");
+    const Json& law = s["modulus_law"];
+    checkObject(law, { "a", "b", "c" }, where + ".modulus_law");
+    m.modulus.a = numberAt(law, "a", m.modulus.a, where + ".modulus_law");
+    m.modulus.b = numberAt(law, "b", m.modulus.b, where + ".modulus_law");
+    m.modulus.c = numberAt(law, "c", m.modulus.c, where + ".modulus_law");
+  }
+  if (s.contains("sampling") && !s["sampling"].is_string())
+  {
+    throw UserError(where + ": \"sampling\" must be \"integrated\" or \"centroid\"");
   }
   const std::string sampling = s.value("sampling", std::string("integrated"));
   if (sampling != "integrated" && sampling != "centroid")
@@ -142,19 +235,30 @@ StudySettings readSettings(const std::string& path)
   m.minimumModulus = numberAt(s, "minimum_modulus", m.minimumModulus, where);
   if (s.contains("solve"))
   {
+    checkObject(s["solve"], { "compression" }, where + ".solve");
     out.compression = numberAt(s["solve"], "compression", 0, where + ".solve");
-    if (!(out.compression > 0) || !std::isfinite(out.compression))
+    if (!(out.compression > 0))
     {
       throw UserError(where + ".solve: \"compression\" must be a positive displacement");
     }
   }
+  if (s.contains("fixed") && !s["fixed"].is_object())
+  {
+    throw UserError(where + ".fixed must be a JSON object of cells' materials");
+  }
   const Json fixed = s.value("fixed", Json::object());
   for (const auto& [name, f] : fixed.items())
   {
+    const std::string at = where + ".fixed." + name;
+    if (!isCell(name) && name != out.scan)
+    {
+      throw UserError(at + ": '" + name + "' is not a cell of the complex");
+    }
+    checkObject(f, { "youngs_modulus", "poisson_ratio", "density" }, at);
     mesh::FixedMaterial fm;
-    fm.youngsModulus = numberAt(f, "youngs_modulus", 0, where + ".fixed." + name);
-    fm.poissonRatio = numberAt(f, "poisson_ratio", 0.3, where + ".fixed." + name);
-    fm.density = numberAt(f, "density", 1, where + ".fixed." + name);
+    fm.youngsModulus = numberAt(f, "youngs_modulus", 0, at);
+    fm.poissonRatio = numberAt(f, "poisson_ratio", 0.3, at);
+    fm.density = numberAt(f, "density", 1, at);
     m.fixed[name] = fm;
   }
   return out;

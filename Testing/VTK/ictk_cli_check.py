@@ -1275,6 +1275,39 @@ def check_study(ictk, work, data):
     # A 0.1 mm shell at size 1: CGAL would lose it (or never finish); refused before meshing.
     refused("thin", r"the implants' protected curves come 0\.0\d+ apart .* use --size 0\.3\d+ or less",
             shell_radius=2.6)
+    # The study object itself: every key is one docs/medical.md lists, of the type it lists, and
+    # every cell it names is a cell of the complex (a misspelt law or material would otherwise
+    # leave a default in force without a word).
+    def settings_refused(name, edit, pattern):
+        doc = json.loads(json.dumps(study))
+        edit(doc["study"])
+        folder = os.path.join(work, name)
+        os.makedirs(folder)
+        path = os.path.join(folder, "study.json")
+        json.dump(doc, open(path, "w"), indent=2)
+        p = run(ictk, ["study", path, "-o", os.path.join(folder, "x.vtu")], check=False)
+        first = p.stderr.splitlines()[0] if p.stderr else ""
+        if p.returncode != 2 or not re.search(pattern, first) or not first.startswith("ictk: error: "):
+            sys.exit(f"FAIL: {name}: exit {p.returncode}, stderr:\n{p.stderr}")
+        if [f for f in os.listdir(folder) if f.startswith("x.")]:
+            sys.exit(f"FAIL: {name}: output written despite the error")
+
+    settings_refused("misspelt-key", lambda s: s.update({"modulus_lwa": {"a": 1}}),
+                     r"study: unknown key \"modulus_lwa\" \(known: \"size\", ")
+    settings_refused("law-not-object", lambda s: s.update({"density_law": 5}),
+                     r"study\.density_law must be a JSON object")
+    settings_refused("law-key", lambda s: s["modulus_law"].update({"d": 2}),
+                     r"study\.modulus_law: unknown key \"d\" \(known: \"a\", \"b\", \"c\"\)")
+    settings_refused("fixed-unknown-cell", lambda s: s["fixed"].update({"shel": {"youngs_modulus": 1}}),
+                     r"study\.fixed\.shel: 'shel' is not a cell of the complex")
+    settings_refused("fixed-not-object", lambda s: s["fixed"].update({"shell": 3}),
+                     r"study\.fixed\.shell must be a JSON object")
+    settings_refused("implant-unknown-cell", lambda s: s.update({"implants": ["implant", "pin"]}),
+                     r"study: \"implants\" names 'pin', which is not a cell of the complex")
+    settings_refused("scan-not-string", lambda s: s.update({"scan": 3}),
+                     r"study: \"scan\" must be a string")
+    settings_refused("size-negative", lambda s: s.update({"size": -1}),
+                     r"study: \"size\" must be a positive element size")
     # The implant library's parameters are checked where the study file gives them: a screw of
     # negative pitch is the complex file's diagnostic naming the function and the parameter.
     folder = os.path.join(work, "pitch")
