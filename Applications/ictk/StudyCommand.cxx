@@ -176,8 +176,7 @@ StudySettings readSettings(const std::string& path)
   }
   const auto isCell = [&](const std::string& name)
   {
-    return !name.empty() &&
-      std::find(cellNames.begin(), cellNames.end(), name) != cellNames.end();
+    return !name.empty() && std::find(cellNames.begin(), cellNames.end(), name) != cellNames.end();
   };
   if (!isCell(out.scan))
   {
