@@ -88,6 +88,33 @@ TEST_P(MeshSolvers, BarOfDataKeepsItsEdgesAndVolume)
   }
 }
 
+TEST_P(MeshSolvers, BarAboutOneElementThickIsValid)
+{
+  // At sizes near the bar's thickness (0.2) CGAL joined four points of one planar face into flat
+  // tetrahedra (9 at size 0.2, 19 at 0.15, volumes down to 1e-14), and the mesh was refused;
+  // they lie on the boundary, and removeFlatBoundaryTetrahedra takes them out.
+  const complex::Complex k =
+    lang::readComplexFile(std::string(ICTK_DATA_DIR) + "/Models/bar/two_material_bar.json");
+  for (const double size : { 0.15, 0.2 })
+  {
+    mesh::ValidityReport v;
+    const mesh::TetMesh m = meshOf(k, size, true, v);
+    SCOPED_TRACE("size " + std::to_string(size));
+    EXPECT_TRUE(v.valid()) << mesh::formatValidityReport(v);
+    EXPECT_EQ(v.smallVolumes, 0u);
+    const auto volumes = materialVolumes(m);
+    ASSERT_EQ(volumes.size(), 2u);
+    EXPECT_NEAR(volumes.at(1) + volumes.at(2), 0.08, 1e-3 * 0.08);
+    if (GetParam() == mesh::Backend::Cgal)
+    {
+      // TetGen's interface follows its surface sampling: 0.015 off x = 1 at size 0.15 (1.5 % of
+      // a block's volume). CGAL's is protected and exact.
+      EXPECT_NEAR(volumes.at(1), 0.04, 1e-3 * 0.04);
+      EXPECT_NEAR(volumes.at(2), 0.04, 1e-3 * 0.04);
+    }
+  }
+}
+
 TEST_P(MeshSolvers, FourMaterialBarKeepsItsBlocks)
 {
   // Issue 21 saw the micro-tetrahedra on every interface of a bar of more materials: four unit

@@ -196,3 +196,85 @@ TEST(MeshValidity, WritersRefuseAnInvalidMeshAndLeaveNoFile)
   EXPECT_TRUE(fs::is_empty(dir)) << "no temporary file left";
   fs::remove_all(dir);
 }
+
+namespace
+{
+
+/// A square pyramid's two tetrahedra over the unit square's diagonal a-c (apex above), the two of
+/// a pyramid below over the other diagonal b-d (when `below`), and the flat tetrahedron of the
+/// square's four corners between them, each tetrahedron positively oriented where it has volume.
+TetMesh squareWithFlatTetrahedron(bool below)
+{
+  TetMesh m;
+  m.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0.5, 0.5, 1 },
+    { 0.5, 0.5, -1 } };
+  const auto add = [&](std::array<std::uint32_t, 4> t)
+  {
+    if (orientation(m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]) < 0)
+    {
+      std::swap(t[2], t[3]);
+    }
+    m.tetrahedra.push_back(t);
+    m.cells.push_back(0);
+    m.materials.push_back(1);
+  };
+  add({ 0, 1, 2, 4 });
+  add({ 0, 2, 3, 4 });
+  if (below)
+  {
+    add({ 0, 1, 3, 5 });
+    add({ 1, 2, 3, 5 });
+  }
+  else
+  {
+    m.points.pop_back();
+  }
+  add({ 0, 1, 2, 3 });
+  m.materialNames = { "block" };
+  m.cellData.push_back({ "id", 1, {} });
+  for (std::size_t t = 0; t < m.tetrahedra.size(); ++t)
+  {
+    m.cellData[0].values.push_back(double(t));
+  }
+  return m;
+}
+
+} // namespace
+
+TEST(MeshValidity, FlatTetrahedraOnTheBoundaryAreRemoved)
+{
+  // The flat tetrahedron under a pyramid: its faces on the a-c diagonal are the pyramid's, those
+  // on b-d the boundary. Removed, the pyramid's two faces are the boundary over the same square.
+  TetMesh m = squareWithFlatTetrahedron(false);
+  EXPECT_EQ(checkValidity(m, 1.0).smallVolumes, 1u);
+  EXPECT_EQ(removeFlatBoundaryTetrahedra(m, 1.0), 1u);
+  ASSERT_EQ(m.tetrahedra.size(), 2u);
+  EXPECT_EQ(m.points.size(), 5u);
+  EXPECT_EQ(m.cellData[0].values, (std::vector<double>{ 0, 1 }));
+  const ValidityReport r = checkValidity(m, 1.0);
+  EXPECT_TRUE(r.valid()) << formatValidityReport(r);
+  EXPECT_EQ(r.interiorFaces, 1u);
+  EXPECT_EQ(r.boundaryFaces, 6u);
+  // The volume is the pyramid's, 1/3, to the flat tetrahedron's (none).
+  double volume = 0;
+  for (const auto& t : m.tetrahedra)
+  {
+    volume += orientation(m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]) / 6;
+  }
+  EXPECT_NEAR(volume, 1.0 / 3, 1e-15);
+  // Nothing flat is left: a second pass removes nothing.
+  EXPECT_EQ(removeFlatBoundaryTetrahedra(m, 1.0), 0u);
+}
+
+TEST(MeshValidity, FlatTetrahedraBetweenNeighboursAreKept)
+{
+  // Pyramids above (diagonal a-c) and below (diagonal b-d): the flat tetrahedron joins their
+  // faces, and without it they would not be conforming; it stays, and the mesh stays refused.
+  TetMesh m = squareWithFlatTetrahedron(true);
+  EXPECT_EQ(removeFlatBoundaryTetrahedra(m, 1.0), 0u);
+  EXPECT_EQ(m.tetrahedra.size(), 5u);
+  EXPECT_EQ(m.points.size(), 6u);
+  const ValidityReport r = checkValidity(m, 1.0);
+  EXPECT_FALSE(r.valid());
+  EXPECT_EQ(r.smallVolumes, 1u);
+}

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -424,6 +425,193 @@ ValidityReport checkValidity(
       pointText(centroid(mesh, f.v.data(), 3)) + ", of " + cellText(mesh, f.tet) + ")");
   }
   return r;
+}
+
+std::size_t removeFlatBoundaryTetrahedra(TetMesh& mesh, double size, const ValidityLimits& limits)
+{
+  validateStructure(mesh);
+  if (!(size > 0) || !std::isfinite(size))
+  {
+    return 0;
+  }
+  const double threshold = limits.minVolume * size * size * size / (6 * std::sqrt(2.0));
+  const auto volumeOf = [&](const std::array<std::uint32_t, 4>& t)
+  {
+    return orientation(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]) /
+      6;
+  };
+  std::vector<std::size_t> flat;
+  for (std::size_t t = 0; t < mesh.tetrahedra.size(); ++t)
+  {
+    if (std::abs(volumeOf(mesh.tetrahedra[t])) < threshold)
+    {
+      flat.push_back(t);
+    }
+  }
+  if (flat.empty())
+  {
+    return 0;
+  }
+  // The faces of a positively oriented (v0, v1, v2, v3) with outward orientation; this holds by
+  // the vertices' order alone, so it still tells a flat tetrahedron's two sides apart.
+  static constexpr int faces[4][3] = { { 1, 2, 3 }, { 0, 3, 2 }, { 0, 1, 3 }, { 0, 2, 1 } };
+  const auto sorted = [](std::uint32_t a, std::uint32_t b, std::uint32_t c)
+  {
+    std::array<std::uint32_t, 3> k{ a, b, c };
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  // How many tetrahedra hold each face of a flat one (a few faces: one pass over the mesh).
+  std::map<std::array<std::uint32_t, 3>, int> holders;
+  for (const std::size_t t : flat)
+  {
+    for (const auto& f : faces)
+    {
+      const auto& tet = mesh.tetrahedra[t];
+      holders[sorted(tet[f[0]], tet[f[1]], tet[f[2]])] = 0;
+    }
+  }
+  for (const auto& t : mesh.tetrahedra)
+  {
+    for (const auto& f : faces)
+    {
+      const auto it = holders.find(sorted(t[f[0]], t[f[1]], t[f[2]]));
+      if (it != holders.end())
+      {
+        ++it->second;
+      }
+    }
+  }
+  const auto count = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) -> int&
+  {
+    return holders.at(sorted(a, b, c));
+  };
+  std::vector<char> removed(mesh.tetrahedra.size(), 0);
+  std::size_t removedCount = 0;
+  // Removing one flat tetrahedron can expose another behind it: repeat until nothing changes.
+  for (bool changed = true; changed;)
+  {
+    changed = false;
+    for (const std::size_t t : flat)
+    {
+      if (removed[t])
+      {
+        continue;
+      }
+      const auto& tet = mesh.tetrahedra[t];
+      std::array<Point3, 4> area{};
+      std::size_t largest = 0;
+      for (int f = 0; f < 4; ++f)
+      {
+        const Point3& a = mesh.points[tet[faces[f][0]]];
+        area[f] =
+          cross(sub(mesh.points[tet[faces[f][1]]], a), sub(mesh.points[tet[faces[f][2]]], a));
+        largest = dot(area[f], area[f]) > dot(area[largest], area[largest]) ? f : largest;
+      }
+      const Point3 normal = area[largest];
+      const double scale = dot(normal, normal);
+      if (!(scale > 0))
+      {
+        continue; // four points on a line: no side to tell
+      }
+      bool upBoundary = true, downBoundary = true, decided = true;
+      for (int f = 0; f < 4; ++f)
+      {
+        const double side = dot(area[f], normal);
+        const bool boundary = count(tet[faces[f][0]], tet[faces[f][1]], tet[faces[f][2]]) == 1;
+        if (std::abs(side) <= 1e-9 * scale)
+        {
+          // A face of no area belongs to neither side; it must not hide a neighbour.
+          decided = decided && boundary;
+        }
+        else if (side > 0)
+        {
+          upBoundary = upBoundary && boundary;
+        }
+        else
+        {
+          downBoundary = downBoundary && boundary;
+        }
+      }
+      if (!decided || !(upBoundary || downBoundary))
+      {
+        continue;
+      }
+      removed[t] = 1;
+      ++removedCount;
+      changed = true;
+      for (const auto& f : faces)
+      {
+        --count(tet[f[0]], tet[f[1]], tet[f[2]]);
+      }
+    }
+  }
+  if (removedCount == 0)
+  {
+    return 0;
+  }
+  // Compact the tetrahedra and their arrays, then the points the rest still use.
+  const bool perTet = !mesh.cellData.empty();
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < mesh.tetrahedra.size(); ++t)
+  {
+    if (removed[t])
+    {
+      continue;
+    }
+    mesh.tetrahedra[kept] = mesh.tetrahedra[t];
+    mesh.cells[kept] = mesh.cells[t];
+    mesh.materials[kept] = mesh.materials[t];
+    ++kept;
+  }
+  mesh.tetrahedra.resize(kept);
+  mesh.cells.resize(kept);
+  mesh.materials.resize(kept);
+  if (perTet)
+  {
+    for (TetArray& array : mesh.cellData)
+    {
+      const auto n = static_cast<std::size_t>(array.components);
+      std::size_t k = 0;
+      for (std::size_t t = 0; t < removed.size(); ++t)
+      {
+        if (!removed[t])
+        {
+          std::copy_n(array.values.begin() + std::ptrdiff_t(t * n), n,
+            array.values.begin() + std::ptrdiff_t(k * n));
+          ++k;
+        }
+      }
+      array.values.resize(k * n);
+    }
+  }
+  constexpr std::uint32_t unused = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> index(mesh.points.size(), unused);
+  for (const auto& t : mesh.tetrahedra)
+  {
+    for (const std::uint32_t v : t)
+    {
+      index[v] = 0;
+    }
+  }
+  std::uint32_t next = 0;
+  for (std::size_t v = 0; v < mesh.points.size(); ++v)
+  {
+    if (index[v] != unused)
+    {
+      index[v] = next;
+      mesh.points[next++] = mesh.points[v];
+    }
+  }
+  mesh.points.resize(next);
+  for (auto& t : mesh.tetrahedra)
+  {
+    for (std::uint32_t& v : t)
+    {
+      v = index[v];
+    }
+  }
+  return removedCount;
 }
 
 void requireValid(const ValidityReport& report, const std::string& what)

@@ -77,6 +77,18 @@ struct ValidityReport
 ValidityReport checkValidity(const TetMesh& mesh, double size = 0,
   const complex::Complex* complex = nullptr, const ValidityLimits& limits = {});
 
+/// Removes the flat tetrahedra (volume below limits.minVolume of a regular one of edge `size`)
+/// that lie on the mesh's boundary, and the points only they used; returns how many went. CGAL's
+/// refinement leaves such tetrahedra where a solid is about one element thick (the two-material
+/// bar at size 0.15-0.25): four points of one planar face joined across it. A flat tetrahedron's
+/// faces, by their outward area vectors, form two groups that cover the same polygon from its two
+/// sides; when every face of one group is a boundary face, the faces of the other group become
+/// the boundary instead, over the same polygon, so the cells' volumes (to the flat one's volume)
+/// and the surface's conformity are unchanged. A flat tetrahedron with neighbours on both sides
+/// (inside a cell or on an interface) is kept, and checkValidity refuses the mesh as before.
+std::size_t removeFlatBoundaryTetrahedra(
+  TetMesh& mesh, double size, const ValidityLimits& limits = {});
+
 /// Throws std::invalid_argument "<what> is not a valid tetrahedral mesh: <problems>" unless the
 /// report is valid.
 void requireValid(const ValidityReport& report, const std::string& what);

@@ -88,6 +88,7 @@ TetMesh tetrahedralize(const complex::Complex& complex, Backend backend,
 {
   TetMesh mesh = run(complex, backend, options);
   mesh.size = options.size;
+  removeFlatBoundaryTetrahedra(mesh, options.size);
   const ValidityReport report = checkValidity(mesh, options.size, &complex);
   requireValid(report, std::string("the ") + backendName(backend) + " backend's mesh");
   if (validity)
