@@ -16,14 +16,21 @@
 #include "FRep/Sampling.h"
 #include "Geometry/Queries.h"
 
+#include "ictkTimeSeriesWriter.h"
+
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkFloatArray.h>
+#include <vtkImageAlgorithm.h>
 #include <vtkImageData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
 #include <vtkNew.h>
+#include <vtkObjectFactory.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
 #include <vtkXMLImageDataWriter.h>
 
@@ -33,6 +40,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <tuple>
 #include <vector>
@@ -232,17 +240,13 @@ void AddFieldData(vtkImageData* image, const char* name, const std::string& valu
   image->GetFieldData()->AddArray(a);
 }
 
-/// The model at --time: every cell with a field (or --cell), one array each and `f`, the largest
-/// of them (the union of their solids).
-int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
+/// The cells sampled now: --cell, or every cell with a field (2D or 3D, not a mesh) of the
+/// largest dimension among them (a 2D cell's field does not depend on z: among 3D cells it would
+/// be a cylinder).
+std::vector<engine::CellState> CellsToSample(
+  const DynamicSampleOptions& o, const engine::DynamicModel& model)
 {
-  const double t = o.TimeGiven ? o.Time : model.timeRange().first;
-  if (t < model.time())
-  {
-    throw UserError(
-      "--time: t = " + Number(t) + " is before the model's start (" + Number(model.time()) + ")");
-  }
-  model.advanceTo(t, EngineStep(o, model, 0));
+  const double t = model.time();
   const std::vector<engine::CellState> all = model.cells();
   std::vector<engine::CellState> cells;
   if (!o.Cell.empty())
@@ -265,33 +269,36 @@ int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
         "D cell" + (cells[0].dimension >= 2 ? " with an explicit mesh" : "") +
         ", which has no field to sample; `ictk run` writes its discretisation");
     }
+    return cells;
   }
-  else
+  int dimension = 0;
+  for (const engine::CellState& c : all)
   {
-    // The cells of the largest dimension: a 2D cell's field does not depend on z, so 2D cells
-    // among 3D ones would be cylinders.
-    int dimension = 0;
-    for (const engine::CellState& c : all)
+    if (HasField(c))
     {
-      if (HasField(c))
-      {
-        dimension = std::max(dimension, c.dimension);
-      }
-    }
-    for (const engine::CellState& c : all)
-    {
-      if (HasField(c) && c.dimension == dimension)
-      {
-        cells.push_back(c);
-      }
-    }
-    if (cells.empty())
-    {
-      throw UserError("no cell of the instance " + model.activeInstance() + " at t = " + Number(t) +
-        " has a field to sample (2D or 3D, not a mesh; its cells: " + Names(all) +
-        "); `ictk run` writes their discretisation");
+      dimension = std::max(dimension, c.dimension);
     }
   }
+  for (const engine::CellState& c : all)
+  {
+    if (HasField(c) && c.dimension == dimension)
+    {
+      cells.push_back(c);
+    }
+  }
+  if (cells.empty())
+  {
+    throw UserError("no cell of the instance " + model.activeInstance() + " at t = " + Number(t) +
+      " has a field to sample (2D or 3D, not a mesh; its cells: " + Names(all) +
+      "); `ictk run` writes their discretisation");
+  }
+  return cells;
+}
+
+/// The box of the cells as placed now; 2D cells lie in z = 0 (their bounds may be padded along z,
+/// as a blend's are).
+frep::Box3 BoxOf(const std::vector<engine::CellState>& cells)
+{
   frep::Box3 box = EmptyBox();
   for (const engine::CellState& c : cells)
   {
@@ -299,11 +306,16 @@ int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
   }
   if (cells[0].dimension == 2)
   {
-    // 2D cells lie in z = 0 (their bounds may be padded along z, as a blend's are).
     box.lo[2] = box.hi[2] = 0;
   }
-  const std::size_t bytes = o.Double ? sizeof(double) : sizeof(float);
-  const frep::Grid grid = PlanDynamicGrid(o, box, cells.size() + 2, bytes);
+  return box;
+}
+
+/// The cells on the grid: one array each, named after it, and f, the largest of them (the union
+/// of their solids); field data Time and Instance.
+vtkSmartPointer<vtkImageData> SampleCells(const std::vector<engine::CellState>& cells,
+  const frep::Grid& grid, bool asDouble, double t, const std::string& instance)
+{
   vtkSmartPointer<vtkImageData> image = MakeImage(grid);
   const std::int64_t layer = grid.dimensions[0] * grid.dimensions[1];
   const vtkIdType n = static_cast<vtkIdType>(layer * grid.dimensions[2]);
@@ -321,16 +333,16 @@ int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
       SampleLayer(
         grid, *evaluator, k, grid.origin[2] + static_cast<double>(k) * grid.spacing[2], values);
     }
-    vtkSmartPointer<vtkDataArray> a = MakeArray(c.name, n, o.Double);
+    vtkSmartPointer<vtkDataArray> a = MakeArray(c.name, n, asDouble);
     for (vtkIdType i = 0; i < n; ++i)
     {
-      a->SetComponent(i, 0, values[static_cast<std::size_t>(i)]);
-      f[static_cast<std::size_t>(i)] =
-        std::max(f[static_cast<std::size_t>(i)], values[static_cast<std::size_t>(i)]);
+      const auto u = static_cast<std::size_t>(i);
+      a->SetComponent(i, 0, values[u]);
+      f[u] = std::max(f[u], values[u]);
     }
     arrays.push_back(a);
   }
-  vtkSmartPointer<vtkDataArray> union_ = MakeArray("f", n, o.Double);
+  vtkSmartPointer<vtkDataArray> union_ = MakeArray("f", n, asDouble);
   for (vtkIdType i = 0; i < n; ++i)
   {
     union_->SetComponent(i, 0, f[static_cast<std::size_t>(i)]);
@@ -345,7 +357,25 @@ int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
   time->SetName("Time");
   time->InsertNextValue(t);
   image->GetFieldData()->AddArray(time);
-  AddFieldData(image, "Instance", model.activeInstance());
+  AddFieldData(image, "Instance", instance);
+  return image;
+}
+
+/// The model at --time.
+int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
+{
+  const double t = o.TimeGiven ? o.Time : model.timeRange().first;
+  if (t < model.time())
+  {
+    throw UserError(
+      "--time: t = " + Number(t) + " is before the model's start (" + Number(model.time()) + ")");
+  }
+  model.advanceTo(t, EngineStep(o, model, 0));
+  const std::vector<engine::CellState> cells = CellsToSample(o, model);
+  const std::size_t bytes = o.Double ? sizeof(double) : sizeof(float);
+  const frep::Grid grid = PlanDynamicGrid(o, BoxOf(cells), cells.size() + 2, bytes);
+  vtkSmartPointer<vtkImageData> image =
+    SampleCells(cells, grid, o.Double, t, model.activeInstance());
   Write(image, o.Output);
   std::cout << "wrote " << o.Output << " (" << grid.dimensions[0] << " x " << grid.dimensions[1]
             << " x " << grid.dimensions[2] << " points; " << model.name() << " at t = " << t
@@ -355,6 +385,157 @@ int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
     std::cout << ", " << c.name;
   }
   std::cout << ")\n";
+  return 0;
+}
+
+/// --frames: the source of ictkTimeSeriesWriter, one image a requested time. The engine runs
+/// forward through the times as the writer asks for them (a time before the engine's restarts
+/// the model), every frame on the one grid planned for all of them.
+class IcmFrameSource : public vtkImageAlgorithm
+{
+public:
+  static IcmFrameSource* New();
+  vtkTypeMacro(IcmFrameSource, vtkImageAlgorithm);
+
+  const DynamicSampleOptions* Options = nullptr;
+  frep::Grid Grid;
+  std::vector<double> Times;
+  double Step = 1;
+  /// What stopped a frame (a ModelError, a UserError), rethrown once the writer returns.
+  std::exception_ptr Error;
+
+protected:
+  IcmFrameSource() { this->SetNumberOfInputPorts(0); }
+
+  int RequestInformation(
+    vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override
+  {
+    vtkInformation* info = out->GetInformationObject(0);
+    const int extent[6] = { 0, static_cast<int>(this->Grid.dimensions[0]) - 1, 0,
+      static_cast<int>(this->Grid.dimensions[1]) - 1, 0,
+      static_cast<int>(this->Grid.dimensions[2]) - 1 };
+    info->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+    info->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), this->Times.data(),
+      static_cast<int>(this->Times.size()));
+    const double range[2] = { this->Times.front(), this->Times.back() };
+    info->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+    return 1;
+  }
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override
+  {
+    vtkInformation* info = out->GetInformationObject(0);
+    double t = this->Times.front();
+    if (info->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+    {
+      t = info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    }
+    try
+    {
+      if (Interrupted())
+      {
+        this->SetAbortExecute(1);
+        return 1;
+      }
+      if (!this->Model || t < this->Model->time())
+      {
+        this->Model =
+          std::make_unique<engine::DynamicModel>(engine::DynamicModel::load(this->Options->Model));
+        this->Model->start();
+      }
+      this->Model->advanceTo(std::max(t, this->Model->time()), this->Step);
+      vtkSmartPointer<vtkImageData> image = SampleCells(CellsToSample(*this->Options, *this->Model),
+        this->Grid, this->Options->Double, t, this->Model->activeInstance());
+      vtkImageData* output = vtkImageData::GetData(out);
+      output->ShallowCopy(image);
+      output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), t);
+      return 1;
+    }
+    catch (const Cancelled&)
+    {
+      this->SetAbortExecute(1);
+      return 1;
+    }
+    catch (...)
+    {
+      this->Error = std::current_exception();
+      vtkErrorMacro(<< "the frame at t = " << t << " failed");
+      return 0;
+    }
+  }
+
+private:
+  std::unique_ptr<engine::DynamicModel> Model;
+};
+
+vtkStandardNewMacro(IcmFrameSource);
+
+/// --frames T0:T1:DT: the cells at every time as a .pvd series of .vti frames, one grid for all
+/// (--bounds, or the box of the sampled cells at every frame).
+int SampleFrames(const DynamicSampleOptions& o, engine::DynamicModel& model)
+{
+  if (!HasExtension(o.Output, ".pvd"))
+  {
+    throw UserError("-o: with --frames the output is a .pvd series, not '" + o.Output + "'");
+  }
+  const std::vector<double> times = ParseFrames(o.Frames);
+  if (times.front() < model.time())
+  {
+    throw UserError("--frames: T0 = " + Number(times.front()) + " is before the model's start (" +
+      Number(model.time()) + ")");
+  }
+  double spacing = 0;
+  for (std::size_t k = 1; k < times.size(); ++k)
+  {
+    const double d = times[k] - times[k - 1];
+    spacing = spacing > 0 ? std::min(spacing, d) : d;
+  }
+  const double step = EngineStep(o, model, spacing);
+  // The engine alone through the frames first (cheap beside the sampling): the box of every
+  // frame's cells, and their largest count for the memory check.
+  frep::Box3 box = EmptyBox();
+  std::size_t arrays = 0;
+  for (double t : times)
+  {
+    if (Interrupted())
+    {
+      throw Cancelled();
+    }
+    model.advanceTo(std::max(t, model.time()), step);
+    const std::vector<engine::CellState> cells = CellsToSample(o, model);
+    Grow(box, BoxOf(cells));
+    arrays = std::max(arrays, cells.size() + 2);
+  }
+  const std::size_t bytes = o.Double ? sizeof(double) : sizeof(float);
+  vtkNew<IcmFrameSource> source;
+  source->Options = &o;
+  source->Grid = PlanDynamicGrid(o, box, arrays, bytes);
+  source->Times = times;
+  source->Step = step;
+  vtkNew<ictkTimeSeriesWriter> writer;
+  writer->SetInputConnection(source->GetOutputPort());
+  writer->SetFileName(o.Output.c_str());
+  ictkCaptureOutputWindow* messages = CaptureVtkMessages();
+  const std::size_t errorsBefore = messages->Errors.size();
+  const int written = writer->Write();
+  if (source->Error)
+  {
+    std::rethrow_exception(source->Error);
+  }
+  if (Interrupted())
+  {
+    throw Cancelled();
+  }
+  if (!written || messages->Errors.size() > errorsBefore)
+  {
+    throw UserError(messages->Errors.size() > errorsBefore
+        ? messages->FirstCause(errorsBefore)
+        : "cannot sample the frames into '" + o.Output + "'");
+  }
+  const frep::Grid& grid = source->Grid;
+  std::cout << "wrote " << o.Output << " (" << times.size() << " frames of " << grid.dimensions[0]
+            << " x " << grid.dimensions[1] << " x " << grid.dimensions[2]
+            << " points, t = " << times.front() << " .. " << times.back() << ")\n";
   return 0;
 }
 
@@ -513,7 +694,7 @@ int SampleSpaceTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
 
 int SampleDynamicModel(const DynamicSampleOptions& o)
 {
-  if (!HasExtension(o.Output, ".vti"))
+  if (o.Frames.empty() && !HasExtension(o.Output, ".vti"))
   {
     throw UserError("-o: a .icm model is sampled into a .vti image, not '" + o.Output + "'");
   }
@@ -530,7 +711,9 @@ int SampleDynamicModel(const DynamicSampleOptions& o)
   {
     engine::DynamicModel model = engine::DynamicModel::load(o.Model);
     model.start();
-    return o.SpaceTime ? SampleSpaceTime(o, model) : SampleAtTime(o, model);
+    return o.SpaceTime    ? SampleSpaceTime(o, model)
+      : !o.Frames.empty() ? SampleFrames(o, model)
+                          : SampleAtTime(o, model);
   }
   catch (const engine::ModelError& e)
   {

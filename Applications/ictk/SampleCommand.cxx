@@ -64,9 +64,9 @@ public:
     CLI::Option* surface = sample->add_option("--surface", o.Surface,
       "Also extract the surface f = 0 (Flying Edges) into this .vtp, .stl, .ply or .obj");
     CLI::Option* frames = AddFrames(sample, o.Frames,
-      "a space-time model (XYZT, XYT) or an animated .blob at every time, as a .pvd series of .vti "
-      "frames (-o "
-      "name.pvd; the frames go into a folder named after it)");
+      "a space-time model (XYZT, XYT), an animated .blob or a .icm model (its cells, as at "
+      "--time) at every time, as a .pvd series of .vti frames (-o name.pvd; the frames go into a "
+      "folder named after it)");
     CLI::Option* band = sample->add_option("--band", o.Band,
       "With -o name.vdb: keep the points where |f| <= W (in f's units; a distance for a distance "
       "field); default 3 grid spacings");
@@ -173,16 +173,15 @@ private:
   /// A .icm model (DynamicSampling.h): its cells at --time, or one 2D cell's space-time.
   int runDynamic()
   {
-    const char* refused = !o.Frames.empty() ? "--frames"
-      : !o.Surface.empty()                  ? "--surface"
-      : o.Band > 0                          ? "--band"
-      : !o.Params.empty()                   ? "--params"
-                                            : nullptr;
+    const char* refused = !o.Surface.empty() ? "--surface"
+      : o.Band > 0                           ? "--band"
+      : !o.Params.empty()                    ? "--params"
+                                             : nullptr;
     if (refused)
     {
       throw UserError(std::string(refused) + " is not for a dynamic model (.icm): it is sampled " +
-        "at one --time into a .vti, or over its time range with --space-time; `ictk run " +
-        "--frames` writes its frames' meshes");
+        "at --time into a .vti, at every time of --frames into a .pvd, or over its time range " +
+        "with --space-time; `ictk run` writes its frames' meshes");
     }
     CheckThreads(o.Threads);
     DynamicSampleOptions d;
@@ -191,6 +190,7 @@ private:
     d.Cell = o.Cell;
     d.Bounds = o.Bounds;
     d.Dims = o.Dims;
+    d.Frames = o.Frames;
     d.Resolution = o.Resolution;
     d.Time = o.Time;
     d.TimeGiven = o.TimeOption && o.TimeOption->count() > 0;

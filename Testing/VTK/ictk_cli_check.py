@@ -1182,6 +1182,21 @@ def check_sample_icm(ictk, work, data):
         same_sign(values, operand, t, "--time")
         near(image.GetFieldData().GetArray("Time").GetValue(0), t, 0, "the Time field data")
 
+    # --frames: the same at every time, a .pvd series of .vti frames on one grid.
+    pvd = os.path.join(work, "frames.pvd")
+    run(ictk, ["sample", model, "--frames", "0:3:1.5", "--dims", "61,61,1",
+               "--bounds", "-1.5,1.5,-1.5,1.5,0,0", "-o", pvd])
+    for d, operand in zip(pvd_frames(pvd, 3, 1.5), (cross, None, disks)):
+        t = float(d.get("timestep"))
+        image = read_image(os.path.join(work, d.get("file")))
+        if image.GetDimensions() != (61, 61, 1):
+            sys.exit(f"FAIL: frame at t = {t}: dimensions {image.GetDimensions()}")
+        near(image.GetFieldData().GetArray("Time").GetValue(0), t, 0, "a frame's Time")
+        morph = image.GetPointData().GetArray("MORPH")
+        if operand:
+            same_sign([((image.GetPoint(i)[0], image.GetPoint(i)[1]), morph.GetValue(i))
+                       for i in range(image.GetNumberOfPoints())], operand, t, "--frames")
+
     # Without --bounds: the cell's box at t, one layer (a 2D cell lies in z = 0).
     out = os.path.join(work, "box.vti")
     run(ictk, ["sample", model, "--time", "1.5", "--resolution", "16", "-o", out])
@@ -1225,7 +1240,10 @@ def check_sample_icm(ictk, work, data):
 
     x = os.path.join(work, "x.vti")
     refused(["--cell", "NOPE", "-o", x], r"--cell: no cell 'NOPE' in the instance K at t = 0 \(its cells: MORPH\)")
-    refused(["--frames", "0:1:0.5", "-o", os.path.join(work, "x.pvd")], r"--frames is not for a dynamic model")
+    refused(["--surface", os.path.join(work, "x.vtp"), "-o", x], r"--surface is not for a dynamic model")
+    refused(["--frames", "0:1:0.5", "-o", x], r"-o: with --frames the output is a .pvd series")
+    refused(["--frames=-1:1:0.5", "-o", os.path.join(work, "x.pvd")],
+            r"--frames: T0 = -1 is before the model's start \(0\)")
     refused(["--space-time", "--time", "1", "-o", x], r"--time is one cross-section")
     refused(["--time", "-1", "-o", x], r"--time: t = -1 is before the model's start \(0\)")
     refused(["-o", os.path.join(work, "x.vdb")], r"-o: a .icm model is sampled into a .vti image")
