@@ -635,7 +635,7 @@ int SampleSpaceTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
         throw UserError("--space-time: " + cell + " is a " + std::to_string(c.dimension) +
           "D cell" +
           (c.dimension == 3 ? " (its space-time is 4D: sample its cross-sections "
-                              "with --time t, or --frames through `ictk run`)"
+                              "with --time t, or a series of them with --frames T0:T1:DT)"
                             : ", which has no 2D field") +
           "; --space-time takes a 2D cell, whose space-time is a 3D volume");
       }
