@@ -42,6 +42,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -200,22 +201,64 @@ vtkSmartPointer<vtkDataArray> MakeArray(const std::string& name, vtkIdType n, bo
   return a;
 }
 
-/// One z = const layer of the grid (index k) of the cell's field into `out` (nx * ny values at
-/// offset k * nx * ny), evaluated at z = `z`.
-void SampleLayer(const frep::Grid& grid, frep::FieldEvaluator& f, std::int64_t k, double z,
-  std::vector<double>& out)
+/// Layers [k0, k1) of the grid of a field into `out` (nx values a row, row k * ny + j at
+/// (k * ny + j) * nx), at the grid's z, or at z = 0 for every layer when `flat` (a space-time
+/// volume, whose z is t). The rows are shared by `threads` threads (0: the machine's), each with
+/// its own evaluator: an evaluator keeps scratch space.
+void SampleLayers(const frep::Grid& grid, const frep::Field& field, std::int64_t k0,
+  std::int64_t k1, bool flat, int threads, std::vector<double>& out)
 {
   const std::int64_t nx = grid.dimensions[0], ny = grid.dimensions[1];
-  std::vector<double> x(static_cast<std::size_t>(nx)), y(x.size()), zs(x.size(), z);
-  for (std::int64_t i = 0; i < nx; ++i)
+  const std::int64_t first = k0 * ny, rows = (k1 - k0) * ny;
+  const unsigned machine = std::max(1u, std::thread::hardware_concurrency());
+  const std::int64_t workers =
+    std::max<std::int64_t>(1, std::min<std::int64_t>(threads > 0 ? threads : machine, rows));
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(workers));
+  auto work = [&](std::int64_t w)
   {
-    x[static_cast<std::size_t>(i)] = grid.origin[0] + static_cast<double>(i) * grid.spacing[0];
+    try
+    {
+      const auto evaluator = field.evaluator();
+      std::vector<double> x(static_cast<std::size_t>(nx)), y(x.size()), z(x.size());
+      for (std::int64_t i = 0; i < nx; ++i)
+      {
+        x[static_cast<std::size_t>(i)] = grid.origin[0] + static_cast<double>(i) * grid.spacing[0];
+      }
+      for (std::int64_t r = first + w; r < first + rows && !Interrupted(); r += workers)
+      {
+        const std::int64_t k = r / ny, j = r % ny;
+        std::fill(y.begin(), y.end(), grid.origin[1] + static_cast<double>(j) * grid.spacing[1]);
+        std::fill(z.begin(), z.end(),
+          flat ? 0.0 : grid.origin[2] + static_cast<double>(k) * grid.spacing[2]);
+        evaluator->values(
+          x.data(), y.data(), z.data(), out.data() + r * nx, static_cast<std::size_t>(nx));
+      }
+    }
+    catch (...)
+    {
+      errors[static_cast<std::size_t>(w)] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::int64_t w = 1; w < workers; ++w)
+  {
+    pool.emplace_back(work, w);
   }
-  for (std::int64_t j = 0; j < ny; ++j)
+  work(0);
+  for (std::thread& t : pool)
   {
-    std::fill(y.begin(), y.end(), grid.origin[1] + static_cast<double>(j) * grid.spacing[1]);
-    f.values(
-      x.data(), y.data(), zs.data(), out.data() + (k * ny + j) * nx, static_cast<std::size_t>(nx));
+    t.join();
+  }
+  for (const std::exception_ptr& e : errors)
+  {
+    if (e)
+    {
+      std::rethrow_exception(e);
+    }
+  }
+  if (Interrupted())
+  {
+    throw Cancelled();
   }
 }
 
@@ -314,7 +357,7 @@ frep::Box3 BoxOf(const std::vector<engine::CellState>& cells)
 /// The cells on the grid: one array each, named after it, and f, the largest of them (the union
 /// of their solids); field data Time and Instance.
 vtkSmartPointer<vtkImageData> SampleCells(const std::vector<engine::CellState>& cells,
-  const frep::Grid& grid, bool asDouble, double t, const std::string& instance)
+  const frep::Grid& grid, bool asDouble, int threads, double t, const std::string& instance)
 {
   vtkSmartPointer<vtkImageData> image = MakeImage(grid);
   const std::int64_t layer = grid.dimensions[0] * grid.dimensions[1];
@@ -323,16 +366,8 @@ vtkSmartPointer<vtkImageData> SampleCells(const std::vector<engine::CellState>& 
   std::vector<vtkSmartPointer<vtkDataArray>> arrays;
   for (const engine::CellState& c : cells)
   {
-    const auto evaluator = geometry::worldField(*c.shape)->evaluator();
-    for (std::int64_t k = 0; k < grid.dimensions[2]; ++k)
-    {
-      if (Interrupted())
-      {
-        throw Cancelled();
-      }
-      SampleLayer(
-        grid, *evaluator, k, grid.origin[2] + static_cast<double>(k) * grid.spacing[2], values);
-    }
+    SampleLayers(
+      grid, *geometry::worldField(*c.shape), 0, grid.dimensions[2], false, threads, values);
     vtkSmartPointer<vtkDataArray> a = MakeArray(c.name, n, asDouble);
     for (vtkIdType i = 0; i < n; ++i)
     {
@@ -375,7 +410,7 @@ int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
   const std::size_t bytes = o.Double ? sizeof(double) : sizeof(float);
   const frep::Grid grid = PlanDynamicGrid(o, BoxOf(cells), cells.size() + 2, bytes);
   vtkSmartPointer<vtkImageData> image =
-    SampleCells(cells, grid, o.Double, t, model.activeInstance());
+    SampleCells(cells, grid, o.Double, o.Threads, t, model.activeInstance());
   Write(image, o.Output);
   std::cout << "wrote " << o.Output << " (" << grid.dimensions[0] << " x " << grid.dimensions[1]
             << " x " << grid.dimensions[2] << " points; " << model.name() << " at t = " << t
@@ -444,8 +479,9 @@ protected:
         this->Model->start();
       }
       this->Model->advanceTo(std::max(t, this->Model->time()), this->Step);
-      vtkSmartPointer<vtkImageData> image = SampleCells(CellsToSample(*this->Options, *this->Model),
-        this->Grid, this->Options->Double, t, this->Model->activeInstance());
+      vtkSmartPointer<vtkImageData> image =
+        SampleCells(CellsToSample(*this->Options, *this->Model), this->Grid, this->Options->Double,
+          this->Options->Threads, t, this->Model->activeInstance());
       vtkImageData* output = vtkImageData::GetData(out);
       output->ShallowCopy(image);
       output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), t);
@@ -671,7 +707,7 @@ int SampleSpaceTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
     }
     if (const geometry::PlacedShapePtr& s = shapes[static_cast<std::size_t>(k)])
     {
-      SampleLayer(grid, *geometry::worldField(*s)->evaluator(), k, 0.0, values);
+      SampleLayers(grid, *geometry::worldField(*s), k, k + 1, true, o.Threads, values);
     }
   }
   vtkSmartPointer<vtkDataArray> f = MakeArray("f", n, o.Double);

@@ -27,6 +27,7 @@ struct DynamicSampleOptions
   bool SpaceTime = false;
   bool Double = false;
   double MaxStep = 0; ///< the engine's largest step; 0: the rule of `ictk run`
+  int Threads = 0;    ///< the sampling's threads (0: the machine's)
 };
 
 /// Samples and writes the .vti; returns the exit code (UserError, lang::ParseError for the

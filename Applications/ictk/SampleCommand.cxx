@@ -197,6 +197,7 @@ private:
     d.SpaceTime = o.SpaceTime;
     d.Double = o.Double;
     d.MaxStep = o.MaxStep;
+    d.Threads = o.Threads;
     return SampleDynamicModel(d);
   }
 
