@@ -111,11 +111,11 @@ void OnProgress(vtkObject* caller, unsigned long, void* clientData, void* callDa
 
 } // namespace
 
-void GridCommandOptions::AddTo(CLI::App* command, std::int64_t defaultResolution)
+void GridCommandOptions::AddTo(
+  CLI::App* command, std::int64_t defaultResolution, const std::string& modelHelp)
 {
   this->Resolution = defaultResolution;
-  AddModel(
-    command, this->Model, "Model name (see `ictk models`) or a .hf / .xml / .vm / .blob file");
+  AddModel(command, this->Model, modelHelp);
   CLI::Option* resolution = command->add_option("--resolution", this->Resolution,
     "Points per axis (default " + std::to_string(defaultResolution) + ")");
   CLI::Option* dims = command->add_option("--dims", this->Dims, "Points per axis: NX,NY,NZ");

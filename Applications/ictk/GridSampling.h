@@ -46,7 +46,9 @@ struct GridCommandOptions
   bool SpaceTime = false;
 
   /// Adds the model argument and the grid options (not -o, whose help differs per command).
-  void AddTo(CLI::App* command, std::int64_t defaultResolution);
+  void AddTo(CLI::App* command, std::int64_t defaultResolution,
+    const std::string& modelHelp =
+      "Model name (see `ictk models`) or a .hf / .xml / .vm / .blob file");
 };
 
 /// The grid a command samples, checked before anything is allocated or written.

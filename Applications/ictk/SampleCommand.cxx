@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `ictk sample`: a model sampled on a regular grid into a .vti (f and the attributes), optionally
 // with its surface f = 0; or, with -o name.vdb, only the narrow band |f| <= band into a sparse
-// OpenVDB grid (voxel::sampleNarrowBand), whose memory follows the surface.
+// OpenVDB grid (voxel::sampleNarrowBand), whose memory follows the surface. A dynamic model (.icm)
+// is sampled by DynamicSampling.h.
 #include "Command.h"
+#include "DynamicSampling.h"
 #include "GridSampling.h"
 #include "Options.h"
 #include "Output.h"
@@ -37,6 +39,8 @@ struct SampleCommandOptions : GridCommandOptions
   std::string Surface;
   std::string Frames;
   double Band = 0;
+  std::string Cell;
+  double MaxStep = 0;
 };
 
 class SampleCommand final : public Command
@@ -44,22 +48,35 @@ class SampleCommand final : public Command
 public:
   CLI::App* add(CLI::App& app) override
   {
-    CLI::App* sample = app.add_subcommand(
-      "sample", "Sample a model on a regular grid (.vti), or its narrow band (.vdb)");
-    o.AddTo(sample, 64);
+    CLI::App* sample = app.add_subcommand("sample",
+      "Sample a model on a regular grid (.vti), or its narrow band (.vdb). A dynamic model "
+      "(.icm) is run by the engine to --time (default: its start) and the active instance's "
+      "cells with a field (2D or 3D, not meshes; a space-time cell at its cross-section) are "
+      "sampled, one array per cell and f, their largest (the union); with --space-time, one 2D "
+      "cell (--cell) at every time of the model's time range (or --bounds' z0,z1) as a 3D volume "
+      "whose z is t");
+    o.AddTo(sample, 64,
+      "Model name (see `ictk models`), a .hf / .xml / .vm / .blob file, or a dynamic model "
+      "(.icm)");
     AddOutput(sample, o.Output,
       "Output image (.vti), or a sparse OpenVDB grid of the narrow band (.vdb, see --band)");
     sample->add_flag("--double", o.Double, "Write double-precision arrays (default float)");
     CLI::Option* surface = sample->add_option("--surface", o.Surface,
       "Also extract the surface f = 0 (Flying Edges) into this .vtp, .stl, .ply or .obj");
     CLI::Option* frames = AddFrames(sample, o.Frames,
-      "a space-time model (XYZT, XYT) or an animated .blob at every time, as a .pvd series of .vti "
-      "frames (-o "
-      "name.pvd; the frames go into a folder named after it)");
+      "a space-time model (XYZT, XYT), an animated .blob or a .icm model (its cells, as at "
+      "--time) at every time, as a .pvd series of .vti frames (-o name.pvd; the frames go into a "
+      "folder named after it)");
     CLI::Option* band = sample->add_option("--band", o.Band,
       "With -o name.vdb: keep the points where |f| <= W (in f's units; a distance for a distance "
       "field); default 3 grid spacings");
     band->check(CLI::PositiveNumber);
+    sample->add_option("--cell", o.Cell,
+      "A .icm model: sample only this cell (with --space-time: the 2D cell whose space-time is "
+      "sampled; default the model's one space-time 2D cell)");
+    sample->add_option("--max-step", o.MaxStep,
+      "A .icm model: the engine's largest step on the way to --time (default: 1/100 of the "
+      "model's time range, as `ictk run`; with --space-time the spacing of the times)");
     frames->excludes(surface);
     frames->excludes(band);
     frames->excludes(sample->get_option("--time"));
@@ -69,6 +86,15 @@ public:
 
   int run() override
   {
+    if (HasExtension(o.Model, ".icm"))
+    {
+      return runDynamic();
+    }
+    if (!o.Cell.empty() || o.MaxStep != 0)
+    {
+      throw UserError(std::string(!o.Cell.empty() ? "--cell" : "--max-step") +
+        " is for a dynamic model (.icm); '" + o.Model + "' is not one");
+    }
     if (!o.Surface.empty() && !IsSurfaceFormat(o.Surface))
     {
       throw UserError("--surface: '" + o.Surface + "' is not a " + SurfaceFormats + " file");
@@ -144,6 +170,37 @@ public:
   }
 
 private:
+  /// A .icm model (DynamicSampling.h): its cells at --time, or one 2D cell's space-time.
+  int runDynamic()
+  {
+    const char* refused = !o.Surface.empty() ? "--surface"
+      : o.Band > 0                           ? "--band"
+      : !o.Params.empty()                    ? "--params"
+                                             : nullptr;
+    if (refused)
+    {
+      throw UserError(std::string(refused) + " is not for a dynamic model (.icm): it is sampled " +
+        "at --time into a .vti, at every time of --frames into a .pvd, or over its time range " +
+        "with --space-time; `ictk run` writes its frames' meshes");
+    }
+    CheckThreads(o.Threads);
+    DynamicSampleOptions d;
+    d.Model = o.Model;
+    d.Output = o.Output;
+    d.Cell = o.Cell;
+    d.Bounds = o.Bounds;
+    d.Dims = o.Dims;
+    d.Frames = o.Frames;
+    d.Resolution = o.Resolution;
+    d.Time = o.Time;
+    d.TimeGiven = o.TimeOption && o.TimeOption->count() > 0;
+    d.SpaceTime = o.SpaceTime;
+    d.Double = o.Double;
+    d.MaxStep = o.MaxStep;
+    d.Threads = o.Threads;
+    return SampleDynamicModel(d);
+  }
+
   /// -o name.vdb: the narrow band into a sparse OpenVDB grid (f only; no attributes, no dense
   /// memory budget: memory follows the band).
   int runNarrowBand()

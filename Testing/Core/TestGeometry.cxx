@@ -126,6 +126,59 @@ TEST(GeometryShapes, ValuesOfEachPart)
   EXPECT_THROW(segment({ 0, 0, 0 }, { 1, 0, 0 }).value({ 0, 0, 0 }), std::invalid_argument);
 }
 
+TEST(GeometryShapes, BlendIsTheBlendingUnionWithItsScales)
+{
+  // Thesis L643-L645 with a1 = 0.5, a2 = 2: disks of radius 1 at (-1.5, 0) and (1.5, 0); at
+  // (-0.75, 0.5) f1 = 1 - |(0.75, 0.5)| and f2 = 1 - |(-2.25, 0.5)|.
+  auto a = std::make_shared<PlacedShape>(disk(1, at(-1.5, 0), "a"));
+  auto b = std::make_shared<PlacedShape>(disk(1, at(1.5, 0), "b"));
+  ShapePart blend;
+  blend.kind = ShapePart::Kind::Blend;
+  blend.operandA = a;
+  blend.operandB = b;
+  blend.amount = 0.8;
+  blend.a1 = 0.5;
+  blend.a2 = 2;
+  const PlacedShape s = shapeOf("blend", 2, blend);
+  const double f1 = 1 - std::hypot(0.75, 0.5), f2 = 1 - std::hypot(2.25, 0.5);
+  const double want =
+    f1 + f2 + std::hypot(f1, f2) + 0.8 / (1 + (f1 / 0.5) * (f1 / 0.5) + (f2 / 2) * (f2 / 2));
+  EXPECT_NEAR(s.value({ -0.75, 0.5, 0 }), want, 1e-14);
+  // The gradient is the formula's (central differences, h = 1e-6).
+  const auto field = ictk::geometry::worldField(s);
+  const auto evaluator = field->evaluator();
+  ictk::frep::Point3 g;
+  EXPECT_NEAR(evaluator->gradient({ -0.75, 0.5, 0 }, g), want, 1e-14);
+  const double h = 1e-6;
+  EXPECT_NEAR(
+    g[0], (s.value({ -0.75 + h, 0.5, 0 }) - s.value({ -0.75 - h, 0.5, 0 })) / (2 * h), 1e-6);
+  EXPECT_NEAR(
+    g[1], (s.value({ -0.75, 0.5 + h, 0 }) - s.value({ -0.75, 0.5 - h, 0 })) / (2 * h), 1e-6);
+  // The interval bound encloses the values of a box.
+  const ictk::frep::Interval bound = evaluator->bound({ { -1, 0.25, 0 }, { -0.5, 0.75, 0 } });
+  for (double x = -1; x <= -0.5; x += 0.05)
+    for (double y = 0.25; y <= 0.75; y += 0.05)
+    {
+      EXPECT_LE(bound.lo, s.value({ x, y, 0 }));
+      EXPECT_GE(bound.hi, s.value({ x, y, 0 }));
+    }
+  // Next to a far operand the R-union keeps the near one's value: f1 = 0.5 at the disk's
+  // centre, f2 = 1 - 1e17 there. f1 + f2 + sqrt(f1^2 + f2^2) computed as written gives 0 (f1 is
+  // lost in the sum), a point on the surface; the union is 0.5 + 0.5^2 / (2 |f2|) + ... = 0.5.
+  auto far = std::make_shared<PlacedShape>(disk(1, at(1e17, 0), "far"));
+  auto half = std::make_shared<PlacedShape>(disk(0.5, at(0, 0), "half"));
+  ShapePart r = blend;
+  r.operandA = half;
+  r.operandB = far;
+  r.amount = 0;
+  r.a1 = r.a2 = 1;
+  EXPECT_DOUBLE_EQ(shapeOf("r", 2, r).value({ 0, 0, 0 }), 0.5);
+  // Scales must be positive.
+  ShapePart bad = blend;
+  bad.a2 = 0;
+  EXPECT_THROW(shapeOf("bad", 2, bad).value({ 0, 0, 0 }), std::invalid_argument);
+}
+
 TEST(GeometryShapes, WorldBounds)
 {
   // A unit disk turned by 30 degrees and stretched 2x along local x: the ellipse's half-widths

@@ -1152,3 +1152,30 @@ TEST(SpaceTimeBlend, ScalingAlongTimeStretchesTheTransition)
     }
   }
 }
+
+TEST(SpaceTimeBlend, HyperFunRefusesAlignAndWarpAtTheirPlaceNamingTheIcmWay)
+{
+  // hfSpaceTimeBlend gets the operands' values at x, so it cannot evaluate them at moved points
+  // (align, warp): an argument after a3 is refused where it is, not ignored.
+  const std::string text =
+    "m(x[4], a[1])\n{\n  f1 = 0.25 - x[1]^2 - x[2]^2;\n"
+    "  f2 = 0.09 - x[1]^2 - x[2]^2;\n"
+    "  m = hfSpaceTimeBlend(f1, f2, x[4], 0, 1, 1, 0.5, 0.5, 0.1, 0.5);\n}\n";
+  try
+  {
+    ictk::lang::readHyperFun(text, "stb.hf");
+    FAIL() << "an align argument was accepted";
+  }
+  catch (const ictk::lang::ParseError& e)
+  {
+    ASSERT_EQ(e.diagnostics().size(), 1u) << e.what();
+    const ictk::lang::Diagnostic& d = e.diagnostics()[0];
+    EXPECT_EQ(d.where.line, 5);
+    EXPECT_EQ(d.where.column, 62);
+    EXPECT_NE(d.message.find("no align or warp"), std::string::npos) << d.message;
+    EXPECT_NE(d.message.find("spaceTimeBlendCells in .icm models"), std::string::npos) << d.message;
+  }
+  // The nine arguments still read.
+  const std::string nine = text.substr(0, text.find(", 0.5);")) + ");\n}\n";
+  EXPECT_NO_THROW(ictk::lang::readHyperFun(nine, "stb.hf"));
+}

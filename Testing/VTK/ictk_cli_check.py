@@ -6,6 +6,7 @@ Usage: ictk_cli_check.py --ictk PATH --work DIR CHECK [ARGS...]
   models | eval-json | eval-plain | sample-sphere | sample-walnut | sample-disk2d | bench
   | bench-scaling | bench-peer | render
   run-disk DATA | run-errors DATA   (ictk run on the .icm models in DATA/Models/icm)
+  sample-icm DATA   (ictk sample on DATA/Models/icm/ch5_3_space_time_blend.icm)
   tetra-bar DATA | solve-bar DATA   (ictk tetra and ictk solve on DATA/Models/bar)
   study DATA   (ictk study on DATA/Studies/ct-implant and its bad inputs; needs invesalius-examples)
   expect-error REGEX -- ICTK-ARGS...   (exit code 2, one 'ictk: error:' line matching REGEX)
@@ -1112,6 +1113,172 @@ def check_sample_frames(ictk, work, data):
     no_leftovers(work)
 
 
+def slice_components(inside, nx, ny):
+    """The 4-connected components of the True cells of an nx x ny slice (row-major, x fastest)."""
+    seen = [False] * (nx * ny)
+    count = 0
+    for start in range(nx * ny):
+        if not inside[start] or seen[start]:
+            continue
+        count += 1
+        seen[start] = True
+        stack = [start]
+        while stack:
+            p = stack.pop()
+            i, j = p % nx, p // nx
+            for q, ok in ((p - 1, i > 0), (p + 1, i < nx - 1), (p - nx, j > 0), (p + nx, j < ny - 1)):
+                if ok and inside[q] and not seen[q]:
+                    seen[q] = True
+                    stack.append(q)
+    return count
+
+
+def check_sample_icm(ictk, work, data):
+    """A .icm model sampled (issue 16): thesis fig. 93's cross into two disks
+    (Data/Models/icm/ch5_3_space_time_blend.icm, MORPH = spaceTimeBlendCells(CROSS, DISKS, 1, 2,
+    ...)). At --time 0.5 the cell MORPH is the cross in sign, at 2.5 the two disks; --space-time
+    writes its XYT volume, z = t, whose slices before t0 = 1 and after t1 = 2 equal the operands in
+    sign and have 1 and 2 components; bad options and a bad model exit 2 with their message."""
+    model = os.path.join(data, "Models", "icm", "ch5_3_space_time_blend.icm")
+
+    def cross(x, y):
+        return max(min(1 - abs(x), 0.25 - abs(y)), min(0.25 - abs(x), 1 - abs(y)))
+
+    def disks(x, y):
+        return max(0.16 - (x + 0.7) ** 2 - y * y, 0.16 - (x - 0.7) ** 2 - y * y)
+
+    def same_sign(values, operand, t, what):
+        """values[i] at the slice's points against the operand; points within 0.02 of the
+        operand's boundary (the sampled field is not the operand's) are skipped."""
+        compared = 0
+        for (x, y), v in values:
+            w = operand(x, y)
+            if abs(w) < 0.02:
+                continue
+            compared += 1
+            if (v > 0) != (w > 0):
+                sys.exit(f"FAIL: {what} at t = {t}: f({x:.3f}, {y:.3f}) = {v}, the operand {w}")
+        if compared < 1000:
+            sys.exit(f"FAIL: {what} at t = {t}: only {compared} points compared")
+
+    # One time: the cell's cross-section there, array MORPH and the union f (the only cell).
+    for t, operand in ((0.5, cross), (2.5, disks)):
+        out = os.path.join(work, f"at{t}.vti")
+        p = run(ictk, ["sample", model, "--time", str(t), "--dims", "61,61,1",
+                       "--bounds", "-1.5,1.5,-1.5,1.5,0,0", "-o", out])
+        if "instance K" not in p.stdout or "arrays: f, MORPH" not in p.stdout:
+            sys.exit(f"FAIL: summary: {p.stdout}")
+        image = read_image(out)
+        if image.GetDimensions() != (61, 61, 1):
+            sys.exit(f"FAIL: dimensions {image.GetDimensions()}")
+        morph = image.GetPointData().GetArray("MORPH")
+        f = image.GetPointData().GetArray("f")
+        values = []
+        for i in range(image.GetNumberOfPoints()):
+            x, y, _ = image.GetPoint(i)
+            if f.GetValue(i) != morph.GetValue(i):
+                sys.exit(f"FAIL: f != MORPH at point {i}")
+            values.append(((x, y), morph.GetValue(i)))
+        same_sign(values, operand, t, "--time")
+        near(image.GetFieldData().GetArray("Time").GetValue(0), t, 0, "the Time field data")
+
+    # --frames: the same at every time, a .pvd series of .vti frames on one grid.
+    pvd = os.path.join(work, "frames.pvd")
+    run(ictk, ["sample", model, "--frames", "0:3:1.5", "--dims", "61,61,1",
+               "--bounds", "-1.5,1.5,-1.5,1.5,0,0", "-o", pvd])
+    for d, operand in zip(pvd_frames(pvd, 3, 1.5), (cross, None, disks)):
+        t = float(d.get("timestep"))
+        image = read_image(os.path.join(work, d.get("file")))
+        if image.GetDimensions() != (61, 61, 1):
+            sys.exit(f"FAIL: frame at t = {t}: dimensions {image.GetDimensions()}")
+        near(image.GetFieldData().GetArray("Time").GetValue(0), t, 0, "a frame's Time")
+        morph = image.GetPointData().GetArray("MORPH")
+        if operand:
+            same_sign([((image.GetPoint(i)[0], image.GetPoint(i)[1]), morph.GetValue(i))
+                       for i in range(image.GetNumberOfPoints())], operand, t, "--frames")
+
+    # Without --bounds: the cell's box at t, one layer (a 2D cell lies in z = 0).
+    out = os.path.join(work, "box.vti")
+    run(ictk, ["sample", model, "--time", "1.5", "--resolution", "16", "-o", out])
+    if read_image(out).GetDimensions() != (16, 16, 1):
+        sys.exit(f"FAIL: a 2D cell's grid: {read_image(out).GetDimensions()}")
+
+    # The space-time volume: 61 x 61 points, 31 times 0, 0.1, ..., 3.
+    out = os.path.join(work, "morph.vti")
+    p = run(ictk, ["sample", model, "--space-time", "--cell", "MORPH", "--dims", "61,61,31",
+                   "--bounds", "-1.5,1.5,-1.5,1.5,0,3", "-o", out])
+    image = read_image(out)
+    if image.GetDimensions() != (61, 61, 31):
+        sys.exit(f"FAIL: space-time dimensions {image.GetDimensions()}")
+    near(image.GetSpacing()[2], 0.1, 1e-12, "the time spacing")
+    f = image.GetPointData().GetArray("f")
+    layer = 61 * 61
+    components = []
+    for k in range(31):
+        t = image.GetPoint(k * layer)[2]
+        near(t, 0.1 * k, 1e-9, f"z of slice {k}")
+        values = [((image.GetPoint(k * layer + i)[0], image.GetPoint(k * layer + i)[1]),
+                   f.GetValue(k * layer + i)) for i in range(layer)]
+        if t <= 1 + 1e-9:
+            same_sign(values, cross, t, "--space-time before t0")
+        if t >= 2 - 1e-9:
+            same_sign(values, disks, t, "--space-time after t1")
+        components.append(slice_components([v > 0 for _, v in values], 61, 61))
+    if components[0] != 1 or components[-1] != 2 or any(c != 1 for c in components[:11]) \
+            or any(c != 2 for c in components[20:]):
+        sys.exit(f"FAIL: components per slice {components}")
+    # The model's only space-time 2D cell is the default; its time range (0, 3) the default z.
+    out2 = os.path.join(work, "default.vti")
+    p = run(ictk, ["sample", model, "--space-time", "--resolution", "16", "-o", out2])
+    if "the space-time of MORPH, z = t from 0 to 3" not in p.stdout:
+        sys.exit(f"FAIL: default space-time summary: {p.stdout}")
+
+    def refused(args, pattern):
+        p = run(ictk, ["sample", model] + args, check=False)
+        if p.returncode != 2 or not re.search(pattern, p.stderr):
+            sys.exit(f"FAIL: {args}: exit {p.returncode}, stderr:\n{p.stderr}")
+
+    x = os.path.join(work, "x.vti")
+    refused(["--cell", "NOPE", "-o", x], r"--cell: no cell 'NOPE' in the instance K at t = 0 \(its cells: MORPH\)")
+    refused(["--surface", os.path.join(work, "x.vtp"), "-o", x], r"--surface is not for a dynamic model")
+    refused(["--frames", "0:1:0.5", "-o", x], r"-o: with --frames the output is a .pvd series")
+    refused(["--frames=-1:1:0.5", "-o", os.path.join(work, "x.pvd")],
+            r"--frames: T0 = -1 is before the model's start \(0\)")
+    refused(["--space-time", "--time", "1", "-o", x], r"--time is one cross-section")
+    refused(["--time", "-1", "-o", x], r"--time: t = -1 is before the model's start \(0\)")
+    refused(["-o", os.path.join(work, "x.vdb")], r"-o: a .icm model is sampled into a .vti image")
+    p = run(ictk, ["sample", "sphere", "--cell", "A", "-o", x], check=False)
+    if p.returncode != 2 or "--cell is for a dynamic model (.icm)" not in p.stderr:
+        sys.exit(f"FAIL: --cell on a registered model: exit {p.returncode}, stderr:\n{p.stderr}")
+    # A 3D cell has a 4D space-time.
+    ball = os.path.join(work, "ball.icm")
+    with open(ball, "w") as fh:
+        fh.write("""name = BALL;
+TIMESPANS { film : TIMESPAN(0, 1); }
+CELLS { B { type = F-CELL; shape = sphere(0.5); dim = 3D; } }
+K { CELLS { B; } }
+""")
+    p = run(ictk, ["sample", ball, "--space-time", "--cell", "B", "-o", x], check=False)
+    if p.returncode != 2 or "its space-time is 4D" not in p.stderr:
+        sys.exit(f"FAIL: a 3D cell's space-time: exit {p.returncode}, stderr:\n{p.stderr}")
+    # A bad blend scale, at its place.
+    bad = os.path.join(work, "bad.icm")
+    with open(bad, "w") as fh:
+        fh.write("""name = BAD;
+TIMESPANS { film : TIMESPAN(0, 1); }
+CELLS {
+  A { type = F-CELL; shape = disk(1); dim = 2D; }
+  B { type = F-CELL; shape = disk(0.5); dim = 2D; parameters { translation(1.5, 0, 0); } }
+  C { type = T-CELL; shape = blend(A, B, 0.5, 1, 0); dim = 2D; }
+}
+K { CELLS { A; B; C; } }
+""")
+    p = run(ictk, ["sample", bad, "-o", x], check=False)
+    if p.returncode != 2 or "bad.icm:6:50: error: the blend scale a2 must be positive" not in p.stderr:
+        sys.exit(f"FAIL: a bad blend scale: exit {p.returncode}, stderr:\n{p.stderr}")
+    no_leftovers(work)
+
+
 def check_run_errors(ictk, work, data):
     """ictk run on bad input: exit 2, a clear message, and nothing written or lost."""
     model = os.path.join(data, "Models", "icm", "ch5_1_disk_rectangle.icm")
@@ -1460,9 +1627,11 @@ def main():
         check_solve_bar(ictk, work, rest[0])
         print("OK")
         return
-    if check in ("run-disk", "run-errors", "run-default", "sample-frames", "run-standin"):
+    if check in ("run-disk", "run-errors", "run-default", "sample-frames", "run-standin",
+                 "sample-icm"):
         {"run-disk": check_run_disk, "run-errors": check_run_errors,
          "run-default": check_run_default, "sample-frames": check_sample_frames,
+         "sample-icm": check_sample_icm,
          "run-standin": check_run_standin}[check](
             ictk, work, rest[0])
         print("OK")

@@ -76,6 +76,7 @@ std::vector<CellState> DynamicModel::cells() const
     st.name = n;
     st.kind = c.kind;
     st.dimension = m.spaceDimension(c);
+    st.spaceTime = c.spaceTime;
     st.shape = m.shapeOf(n);
     st.shapeVersion = m.versionOf(n);
     out.push_back(std::move(st));

@@ -66,6 +66,9 @@ struct CellState
   complex::CellKind kind = complex::CellKind::FRep;
   int dimension = 3;
   geometry::PlacedShapePtr shape; ///< placed in the world
+  /// A space-time cell (XYZT, XYT, spaceTimeBlendCells): `shape` is its cross-section at the
+  /// model's time, of dimension `dimension` (3 for XYZT, 2 for XYT).
+  bool spaceTime = false;
   /// Changes whenever the shape's parts change (a reaction set the shape, a shape parameter
   /// changed, an operand of a blend or union moved); a change of placement alone keeps it, so a
   /// discretisation of the local shape stays valid and only needs moving (time coherence, thesis

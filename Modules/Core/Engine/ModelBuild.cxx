@@ -116,15 +116,7 @@ void ModelState::build()
   // The blend-like shapes' numbers at the start; refused here, at their place, when wrong.
   for (CellSpec& c : cells)
     if (c.operands)
-    {
-      const OperandNumbers n = evaluateOperands(c, kNone);
-      c.operands->amount = n.amount;
-      c.operands->spaceTime = n.spaceTime;
-      c.operands->align = n.align;
-      c.operands->pairs = n.pairs;
-      c.operands->warpCount = n.warpCount;
-      c.operands->warpSeparation = n.warpSeparation;
-    }
+      c.operands->atStart = evaluateOperands(c, kNone);
 }
 
 OperandNumbers ModelState::evaluateOperands(const CellSpec& c, std::size_t instance)
@@ -166,6 +158,17 @@ OperandNumbers ModelState::evaluateOperands(const CellSpec& c, std::size_t insta
           "the blend amount of " + c.name + " must not be negative, it is " +
             std::to_string(v.number));
       out.amount = v.number;
+    }
+    else if (!spaceTimeBlend)
+    {
+      // a1 and a2 divide the operands' values (thesis L645): a scale, so > 0 (a negative one
+      // would be the same as its opposite, and 0 has no meaning).
+      if (!(v.number > 0))
+        fail(e.pos,
+          std::string("the blend scale a") + (i == 1 ? "1" : "2") + " of " + c.name +
+            " (how far the blend reaches into " + (i == 1 ? "cellA" : "cellB") +
+            ") must be positive, it is " + std::to_string(v.number));
+      (i == 1 ? out.a1 : out.a2) = v.number;
     }
   }
   if (!warpArguments.empty())

@@ -263,6 +263,8 @@ void operandsShape(const ShapeCall& s)
   // The numbers are evaluated at every step (ModelState::evaluateOperands).
   for (std::size_t i = 3; i < s.expr.kids.size(); ++i)
     o.numbers.push_back(s.expr.kids[i].get());
+  if (kind == ShapePart::Kind::Blend && o.numbers.size() == 2)
+    s.fail(s.name + ": the scales a1 and a2 come together, after the amount");
   s.c.operands = std::move(o);
 }
 
@@ -316,6 +318,7 @@ const std::pair<ShapeId, ShapeConstructor> kShapes[] = {
   { ShapeId::Box, boxShape },
   { ShapeId::Sphere, roundShape<ShapePart::Kind::Sphere> },
   { ShapeId::Blend, operandsShape<ShapePart::Kind::Blend> },
+  { ShapeId::BlendCells, operandsShape<ShapePart::Kind::Blend> },
   { ShapeId::Union, operandsShape<ShapePart::Kind::Union> },
   { ShapeId::SpaceTimeBlend, spaceTimeBlendShape },
   { ShapeId::LoadMesh, loadMeshShape },

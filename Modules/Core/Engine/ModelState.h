@@ -61,6 +61,25 @@ struct AliasSpec
   ExprPtr path;
 };
 
+/// The numbers of a blend-like shape at one step (CellSpec::Operands).
+struct OperandNumbers
+{
+  /// blend / blendCells: the blending union's a0 (`amount`, the added material) and the
+  /// operands' scales a1, a2 (thesis 2.2.3, L643-L647); 1 when not given.
+  double amount = 0.0;
+  double a1 = 1.0, a2 = 1.0;
+  frep::SpaceTimeBlendParameters spaceTime;
+  /// spaceTimeBlendCells' ninth number: how far the automatic space-time alignment moves each
+  /// operand toward the other's bounding domain (thesis 5.3.2 L3108; 0 = plain blending).
+  double align = 0.0;
+  /// spaceTimeBlendCells' warp (thesis 5.3.3, Geometry/SpaceTimeWarp.h): the control pairs
+  /// given as vec3 source, destination arguments after align, or, when warpCount > 0, that many
+  /// automatic control points of each operand at least warpSeparation apart, paired.
+  std::vector<geometry::ControlPair> pairs;
+  int warpCount = 0;
+  double warpSeparation = 0.0;
+};
+
 struct CellSpec
 {
   std::string name;
@@ -93,16 +112,12 @@ struct CellSpec
   {
     ShapePart::Kind kind = ShapePart::Kind::Union;
     std::string a, b;
-    /// The constructor's numbers (blend: amount; space-time blend: t0, t1, a0, a1, a2, a3),
-    /// expressions over the cell's and the model's parameters evaluated at every step.
+    /// The constructor's numbers (blend: amount [, a1, a2]; space-time blend: t0, t1, a0, a1,
+    /// a2, a3 ...), expressions over the cell's and the model's parameters evaluated at every
+    /// step.
     std::vector<const Expr*> numbers;
     /// Their values at the model's start (ModelState::evaluateOperands).
-    double amount = 0.0;
-    frep::SpaceTimeBlendParameters spaceTime; ///< SpaceTimeBlend only
-    double align = 0.0;                       ///< SpaceTimeBlend only (OperandNumbers::align)
-    std::vector<geometry::ControlPair> pairs; ///< SpaceTimeBlend only (OperandNumbers::pairs)
-    int warpCount = 0;                        ///< SpaceTimeBlend only (OperandNumbers)
-    double warpSeparation = 0.0;              ///< SpaceTimeBlend only (OperandNumbers)
+    OperandNumbers atStart;
     /// The automatic control pairs found for the operands as they were (a hash of their
     /// versions and placements): the distance transforms are redone only when they change.
     mutable std::uint64_t pairedFor = 0;
@@ -170,22 +185,6 @@ struct InstanceSpec
   const Procedure* predicate = nullptr;
   std::set<std::string> reactsTo;
   std::vector<std::pair<std::string, std::string>> attributeLinks; ///< (cell, attribute)
-};
-
-/// The numbers of a blend-like shape at one step (CellSpec::Operands).
-struct OperandNumbers
-{
-  double amount = 0.0;
-  frep::SpaceTimeBlendParameters spaceTime;
-  /// spaceTimeBlendCells' ninth number: how far the automatic space-time alignment moves each
-  /// operand toward the other's bounding domain (thesis 5.3.2 L3108; 0 = plain blending).
-  double align = 0.0;
-  /// spaceTimeBlendCells' warp (thesis 5.3.3, Geometry/SpaceTimeWarp.h): the control pairs
-  /// given as vec3 source, destination arguments after align, or, when warpCount > 0, that many
-  /// automatic control points of each operand at least warpSeparation apart, paired.
-  std::vector<geometry::ControlPair> pairs;
-  int warpCount = 0;
-  double warpSeparation = 0.0;
 };
 
 /// The structural state: what the parameter table cannot hold. Copied with every snapshot.
@@ -280,10 +279,7 @@ struct ModelState
   OperandNumbers operandNumbersOf(const CellSpec& c) const
   {
     const auto it = s.operandNumbers.find(c.name);
-    return it != s.operandNumbers.end()
-      ? it->second
-      : OperandNumbers{ c.operands->amount, c.operands->spaceTime, c.operands->align,
-          c.operands->pairs, c.operands->warpCount, c.operands->warpSeparation };
+    return it != s.operandNumbers.end() ? it->second : c.operands->atStart;
   }
   void buildAnimations();
   void buildEvents();

@@ -415,6 +415,8 @@ PlacedShapePtr ModelState::shapeOf(const std::string& cell, int depth) const
     part.operandA = a;
     part.operandB = b;
     part.amount = n.amount;
+    part.a1 = n.a1;
+    part.a2 = n.a2;
     part.bounds = c.domain;
     shape->parts.push_back(part);
     return shape;
@@ -444,8 +446,8 @@ std::uint64_t ModelState::versionOf(const std::string& cell, int depth) const
   // numbers change.
   const OperandNumbers n = operandNumbersOf(c);
   for (double d :
-    { n.amount, n.spaceTime.t0, n.spaceTime.t1, n.spaceTime.a0, n.spaceTime.a1, n.spaceTime.a2,
-      n.spaceTime.a3, n.align, n.warpSeparation, static_cast<double>(n.warpCount) })
+    { n.amount, n.a1, n.a2, n.spaceTime.t0, n.spaceTime.t1, n.spaceTime.a0, n.spaceTime.a1,
+      n.spaceTime.a2, n.spaceTime.a3, n.align, n.warpSeparation, static_cast<double>(n.warpCount) })
     v = mix(v, bitsOf(d));
   for (const geometry::ControlPair& p : n.pairs)
     for (int k = 0; k < 3; ++k)

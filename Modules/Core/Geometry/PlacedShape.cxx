@@ -145,6 +145,10 @@ void validate(const PlacedShape& s, int depth)
     {
       fail(s, "a shape size, radius or blend amount is negative");
     }
+    if (!(p.a1 > 0 && p.a2 > 0 && std::isfinite(p.a1) && std::isfinite(p.a2)))
+    {
+      fail(s, "a blend's scales a1 and a2 must be positive and finite");
+    }
     switch (p.kind)
     {
       case ShapePart::Kind::Point:

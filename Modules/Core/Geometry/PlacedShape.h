@@ -87,10 +87,13 @@ struct ShapePart
   frep::FieldPtr field; ///< Field: evaluated at local coordinates (z = 0 when 2D)
   int fieldDimension = 3;
   frep::Box3 bounds; ///< Field: the cell's domain (local coordinates)
-  /// Blend / Union: the operands, already placed in the world; Blend's `amount` >= 0 is the
-  /// blending strength (0 = the plain union, max(f1, f2)).
+  /// Blend / Union: the operands, already placed in the world. Blend is Pasko's blending union
+  /// (thesis 2.2.3, L643-L647), f1 + f2 + sqrt(f1^2 + f2^2) + a0 / (1 + (f1/a1)^2 + (f2/a2)^2),
+  /// with a0 = `amount` >= 0 the material added where both operands are near (0: the R-union,
+  /// the same solid as Union's max(f1, f2)) and a1, a2 > 0 how far it reaches into each operand.
   PlacedShapePtr operandA, operandB;
   double amount = 0.0;
+  double a1 = 1.0, a2 = 1.0;
   /// SpaceTimeBlend: the blend's parameters, the time of the cross-section, and the
   /// cross-section's function g(fa, fb) of the operands' values as a field of (x, y) = (fa, fb)
   /// (compiled once; made by spaceTimeBlendPart).

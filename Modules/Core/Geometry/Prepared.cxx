@@ -24,26 +24,35 @@ namespace ictk::geometry::detail
 namespace
 {
 
-// Pasko's blending union, f1 + f2 + sqrt(f1^2 + f2^2) + a0 / (1 + f1^2 + f2^2) (a1 = a2 = 1):
-// an R-function union (its sign is the sign of max(f1, f2)) plus a bump of height a0 where both
-// fields are near 0, which fills the crease between the operands.
-double blendUnion(double f1, double f2, double a0)
-{
-  if (a0 <= 0)
-  {
-    return std::max(f1, f2);
-  }
-  return f1 + f2 + std::hypot(f1, f2) + a0 / (1 + f1 * f1 + f2 * f2);
-}
-// The R-function part is nondecreasing in each argument; the bump is bounded by the ranges of
-// f1^2 + f2^2.
-/// An operand's value as the space-time blend's function takes it: -Inf (outside every part,
-/// or NaN) and huge values would make its squares overflow; beyond 1e150 the cross-section's sign
-/// no longer changes.
+/// An operand's value as the blends take it: -Inf (outside every part, or NaN) and huge values
+/// would make its squares overflow; beyond 1e150 the sign of a blend no longer changes.
 double operandValue(double f)
 {
   return std::isnan(f) ? -1e150 : std::clamp(f, -1e150, 1e150);
 }
+
+/// The R-function union f1 + f2 + sqrt(f1^2 + f2^2) (thesis L620), its sign the sign of
+/// max(f1, f2). Where f1 + f2 < 0 it is computed as 2 f1 f2 / (f1 + f2 - sqrt(f1^2 + f2^2)), the
+/// same number without the cancellation that loses the nearer operand next to a far one
+/// (f1 = -1e9, f2 = 0.5: 0.5, where the sum gives 0).
+double rUnion(double f1, double f2)
+{
+  const double s = f1 + f2, h = std::hypot(f1, f2);
+  return s >= 0 ? s + h : 2 * f1 * f2 / (s - h);
+}
+
+/// Pasko's blending union (thesis 2.2.3, L643-L647): the R-union plus the displacement
+/// a0 / (1 + (f1/a1)^2 + (f2/a2)^2), a bump of height a0 where both fields are near 0 that
+/// fills the crease between the operands; a1 and a2 say how far into each operand it reaches.
+double blendUnion(double f1, double f2, const ShapePart& p)
+{
+  f1 = operandValue(f1);
+  f2 = operandValue(f2);
+  const double q1 = f1 / p.a1, q2 = f2 / p.a2;
+  return rUnion(f1, f2) + p.amount / (1 + q1 * q1 + q2 * q2);
+}
+// The R-function part is nondecreasing in each argument; the bump is bounded by the ranges of
+// f1^2 + f2^2.
 
 /// Where a space-time blend's operand is evaluated for the world point w: w moved by its
 /// warp's backward displacement (SpaceTimeWarp.h), or w itself without a warp.
@@ -100,20 +109,25 @@ double spaceTimeSlice(const PreparedPart& pp, double fa, double fb, Vec3& dg)
   return std::isnan(v) ? -Inf : v;
 }
 
-Interval blendUnion(Interval f1, Interval f2, double a0)
+// The R-union is nondecreasing in each argument (its partial derivatives are 1 + f_i / h >= 0),
+// so its range is between its values at the low and the high corners; the displacement's is
+// bounded by the ranges of (f1/a1)^2 + (f2/a2)^2.
+Interval blendUnion(Interval f1, Interval f2, const ShapePart& p)
 {
-  if (a0 <= 0)
+  // NaN is outside in blendUnion(double...): an enclosure must allow its -1e150.
+  auto low = [](const Interval& f)
   {
-    return ivMax(f1, f2);
-  }
-  if (!std::isfinite(f1.lo) || !std::isfinite(f1.hi) || !std::isfinite(f2.lo) ||
-    !std::isfinite(f2.hi))
+    return f.maybeNaN ? -1e150 : operandValue(f.lo);
+  };
+  auto high = [](const Interval& f)
   {
-    return iv(std::isfinite(f1.lo) && std::isfinite(f2.lo) ? std::max(f1.lo, f2.lo) : -Inf, Inf);
-  }
-  const Interval s1 = ivSquare(f1), s2 = ivSquare(f2);
-  const double lo = f1.lo + f2.lo + std::hypot(f1.lo, f2.lo) + a0 / (1 + s1.hi + s2.hi);
-  const double hi = f1.hi + f2.hi + std::hypot(f1.hi, f2.hi) + a0 / (1 + s1.lo + s2.lo);
+    return std::isnan(f.hi) ? 1e150 : operandValue(f.hi);
+  };
+  const double lo1 = low(f1), hi1 = high(f1), lo2 = low(f2), hi2 = high(f2);
+  const Interval s1 = ivSquare(iv(lo1 / p.a1, hi1 / p.a1)),
+                 s2 = ivSquare(iv(lo2 / p.a2, hi2 / p.a2));
+  const double lo = rUnion(lo1, lo2) + p.amount / (1 + s1.hi + s2.hi);
+  const double hi = rUnion(hi1, hi2) + p.amount / (1 + s1.lo + s2.lo);
   return iv(lo, hi);
 }
 
@@ -309,7 +323,7 @@ double Prepared::partValue(const PreparedPart& pp, Vec3 w) const
   if (p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union)
   {
     const double fa = pp.a->value(w), fb = pp.b->value(w);
-    return p.kind == ShapePart::Kind::Union ? std::max(fa, fb) : blendUnion(fa, fb, p.amount);
+    return p.kind == ShapePart::Kind::Union ? std::max(fa, fb) : blendUnion(fa, fb, p);
   }
   if (p.kind == ShapePart::Kind::SpaceTimeBlend)
   {
@@ -379,7 +393,7 @@ Interval Prepared::partBound(const PreparedPart& pp, const Box3& w) const
   if (p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union)
   {
     const Interval fa = pp.a->bound(w), fb = pp.b->bound(w);
-    return p.kind == ShapePart::Kind::Union ? ivMax(fa, fb) : blendUnion(fa, fb, p.amount);
+    return p.kind == ShapePart::Kind::Union ? ivMax(fa, fb) : blendUnion(fa, fb, p);
   }
   if (p.kind == ShapePart::Kind::SpaceTimeBlend)
   {
@@ -474,19 +488,22 @@ double Prepared::partGradient(const PreparedPart& pp, Vec3 w, Vec3& g) const
   {
     Vec3 ga, gb;
     const double fa = pp.a->gradient(w, ga), fb = pp.b->gradient(w, gb);
-    if (p.kind == ShapePart::Kind::Union || p.amount <= 0)
+    if (p.kind == ShapePart::Kind::Union)
     {
       g = fa >= fb ? ga : gb;
       return std::max(fa, fb);
     }
-    const double h = std::hypot(fa, fb), q = 1 + fa * fa + fb * fb;
-    const double da = 1 + (h > 0 ? fa / h : 0) - 2 * p.amount * fa / (q * q);
-    const double db = 1 + (h > 0 ? fb / h : 0) - 2 * p.amount * fb / (q * q);
+    // d/df1 of the blending union: 1 + f1 / h - 2 a0 f1 / (a1^2 q^2), and likewise for f2.
+    const double f1 = operandValue(fa), f2 = operandValue(fb);
+    const double h = std::hypot(f1, f2);
+    const double q = 1 + (f1 / p.a1) * (f1 / p.a1) + (f2 / p.a2) * (f2 / p.a2);
+    const double da = 1 + (h > 0 ? f1 / h : 0) - 2 * p.amount * f1 / (p.a1 * p.a1 * q * q);
+    const double db = 1 + (h > 0 ? f2 / h : 0) - 2 * p.amount * f2 / (p.a2 * p.a2 * q * q);
     for (int i = 0; i < 3; ++i)
     {
       g[i] = da * ga[i] + db * gb[i];
     }
-    return blendUnion(fa, fb, p.amount);
+    return blendUnion(fa, fb, p);
   }
   if (p.kind == ShapePart::Kind::SpaceTimeBlend)
   {

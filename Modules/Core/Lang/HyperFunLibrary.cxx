@@ -591,6 +591,18 @@ const std::unordered_map<std::string, Compiler::Handler>& Compiler::library()
   // coordinate, normally x[4]; Operations.h spaceTimeBlendExpr.
   L["hfspacetimeblend"] = [=](Frame& f, const ExprNode& n)
   {
+    if (n.kids.size() > 9)
+    {
+      // spaceTimeBlendCells' align and warp (thesis 5.3.2-5.3.3) evaluate an operand at moved
+      // points; this call has the operands' values at x only, so it cannot take them.
+      const ExprNode& extra = node(n.kids[9]);
+      fail(extra.line, extra.column,
+        n.spelling +
+          " takes 9 arguments: it blends the operands' values at x, so it has no align or warp "
+          "(they move the points an operand is evaluated at); those are options of "
+          "spaceTimeBlendCells in .icm models (docs/icm.md), or move the operands' coordinates "
+          "in HyperFun before evaluating them");
+    }
     args(n, 9);
     const Expr f1 = eval(f, n.kids[0]).e;
     const Expr f2 = eval(f, n.kids[1]).e;

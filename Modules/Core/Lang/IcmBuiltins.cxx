@@ -166,9 +166,18 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
     { Id::Box, { "box", 3, 3, "box(real sx, real sy, real sz)", "shape" }, 0,
       "centred on the origin" },
     { Id::Sphere, { "sphere", 1, 1, "sphere(real radius)", "shape" }, 0, "centred on the origin" },
-    { Id::Blend, { "blend", 3, 3, "blend(cellA, cellB, real amount)", "shape" }, 2,
-      "the blended union of two cells' shapes; `amount` (>= 0) may read the cell's and the "
-      "model's parameters: it is evaluated at every step" },
+    { Id::Blend, { "blend", 3, 5, "blend(cellA, cellB, real amount, real a1, real a2)", "shape" },
+      2,
+      "the blending union of two cells' shapes (thesis 2.2.3, L643-L647): f1 + f2 + "
+      "sqrt(f1^2 + f2^2) + amount / (1 + (f1/a1)^2 + (f2/a2)^2), with f1, f2 the cells' fields; "
+      "`amount` (a0 >= 0) is the material added where both are near (0: the R-union, the same "
+      "solid as `union`), a1, a2 (> 0, optional, both or neither, 1 when not given) how far it "
+      "reaches into cellA and cellB; the numbers may read the cell's and the model's "
+      "parameters: they are evaluated at every step" },
+    { Id::BlendCells,
+      { "blendCells", 3, 5, "blendCells(cellA, cellB, real a0, real a1, real a2)", "shape" }, 2,
+      "the thesis's name for `blend` (Appendix B's `IC::blendCells(Box, Liquid_Andy, "
+      "blendDensity, ...)`): the same blending union, the same numbers" },
     { Id::Union, { "union", 2, 2, "union(cellA, cellB)", "shape" }, 2,
       "the union of two cells' shapes" },
     { Id::SpaceTimeBlend,
@@ -212,7 +221,8 @@ const std::vector<ShapeBuiltin>& shapeBuiltins()
 
 const ShapeBuiltin* findShapeBuiltin(const std::string& name)
 {
-  return entryNamed(shapeBuiltins(), name);
+  // The thesis writes `IC::blendCells(...)`, `IC::spaceTimeBlendCells(...)`.
+  return entryNamed(shapeBuiltins(), calledName(name));
 }
 
 std::string shapeBuiltinsMarkdown()

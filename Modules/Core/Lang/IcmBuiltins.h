@@ -120,6 +120,7 @@ enum class ShapeId
   Box,
   Sphere,
   Blend,
+  BlendCells,
   Union,
   SpaceTimeBlend,
   LoadMesh,
@@ -143,7 +144,7 @@ struct ShapeBuiltin
 
 /// The shape constructors, indexed by ShapeId.
 const std::vector<ShapeBuiltin>& shapeBuiltins();
-/// nullptr when `name` is not a shape constructor.
+/// nullptr when `name` is not a shape constructor (`IC::name` is `name`, as for calls).
 const ShapeBuiltin* findShapeBuiltin(const std::string& name);
 /// The rows of docs/icm.md's table of shape constructors ("| `signature` | doc |"), one per entry.
 std::string shapeBuiltinsMarkdown();

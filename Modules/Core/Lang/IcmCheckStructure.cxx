@@ -7,8 +7,31 @@
 
 #include "Complex/Cell.h"
 
+#include <optional>
+
 namespace ictk::lang::icmcheck
 {
+
+namespace
+{
+
+/// A number written out (`0.5`, `-2`): the shape numbers the checker can judge before the
+/// engine evaluates them.
+std::optional<double> writtenNumber(const Expr& e)
+{
+  if (e.kind == Expr::Kind::Number)
+  {
+    return e.number;
+  }
+  if (e.kind == Expr::Kind::Unary && (e.text == "-" || e.text == "+") && e.kids.size() == 1 &&
+    e.kids[0]->kind == Expr::Kind::Number)
+  {
+    return e.text == "-" ? -e.kids[0]->number : e.kids[0]->number;
+  }
+  return std::nullopt;
+}
+
+} // namespace
 
 const std::set<std::string>& Checker::paramsOf(const CellDef* c, int depth) const
 {
@@ -309,6 +332,13 @@ void Checker::shape(
         std::to_string(n));
     return;
   }
+  if ((shape->id == ShapeId::Blend || shape->id == ShapeId::BlendCells) && n == 4)
+  {
+    err(v->kids[4]->pos,
+      "'" + v->text + "' takes the scales a1 and a2 together, after the amount (" + b.signature +
+        "), or neither");
+    return;
+  }
   if (shape->id == ShapeId::File)
   {
     const ExprPtr& a = v->kids[1];
@@ -393,6 +423,24 @@ void Checker::shape(
       err(v->kids[i]->pos,
         "argument " + std::to_string(i) + " of '" + v->text + "' must be a number" +
           (vector ? " or a vec3" : ""));
+    }
+  }
+  // A blend's numbers written out are judged here; expressions when the engine evaluates them
+  // (at load and every step, at the same place).
+  if (shape->id == ShapeId::Blend || shape->id == ShapeId::BlendCells)
+  {
+    for (std::size_t i = 3; i < v->kids.size(); ++i)
+    {
+      const std::optional<double> x = writtenNumber(*v->kids[i]);
+      if (i == 3 && x && *x < 0)
+      {
+        err(v->kids[i]->pos, "the blend amount (a0) must not be negative");
+      }
+      else if (i > 3 && x && !(*x > 0))
+      {
+        err(v->kids[i]->pos,
+          std::string("the blend scale ") + (i == 4 ? "a1" : "a2") + " must be positive");
+      }
     }
   }
 }
