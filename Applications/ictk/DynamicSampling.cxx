@@ -64,20 +64,36 @@ std::string Number(double x)
 }
 
 /// The engine's largest step: --max-step, else the rule of `ictk run` (FrameSequence): the
-/// spacing of the requested times, or 1/100 of the model's time range for one time.
-double EngineStep(const DynamicSampleOptions& o, const engine::DynamicModel& m, double spacing)
+/// spacing of the requested times, or 1/100 of the model's time range for one time. The steps
+/// from the model's time to `end`, the last time `option` asks for, are checked against the
+/// engine's limit (a --time of 1e300 would otherwise step for ever).
+double EngineStep(const DynamicSampleOptions& o, const engine::DynamicModel& m, double spacing,
+  double end, const std::string& option)
 {
+  double step = 1.0;
   if (o.MaxStep > 0)
   {
-    return o.MaxStep;
+    step = o.MaxStep;
   }
-  if (spacing > 0)
+  else if (spacing > 0)
   {
-    return spacing;
+    step = spacing;
   }
-  const auto [t0, t1] = m.timeRange();
-  const double range = t1 - t0;
-  return std::isfinite(range) && range > 0 ? range / 100 : 1.0;
+  else
+  {
+    const auto [t0, t1] = m.timeRange();
+    const double range = t1 - t0;
+    step = std::isfinite(range) && range > 0 ? range / 100 : 1.0;
+  }
+  if (o.MaxStep > 0)
+  {
+    CheckEngineSteps(m.time(), end, step, "--max-step", "a larger --max-step?");
+  }
+  else
+  {
+    CheckEngineSteps(m.time(), end, step, option, "an earlier time, or a larger --max-step?");
+  }
+  return step;
 }
 
 /// The names of the cells, for messages.
@@ -405,7 +421,7 @@ int SampleAtTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
     throw UserError(
       "--time: t = " + Number(t) + " is before the model's start (" + Number(model.time()) + ")");
   }
-  model.advanceTo(t, EngineStep(o, model, 0));
+  model.advanceTo(t, EngineStep(o, model, 0, t, "--time"));
   const std::vector<engine::CellState> cells = CellsToSample(o, model);
   const std::size_t bytes = o.Double ? sizeof(double) : sizeof(float);
   const frep::Grid grid = PlanDynamicGrid(o, BoxOf(cells), cells.size() + 2, bytes);
@@ -526,7 +542,7 @@ int SampleFrames(const DynamicSampleOptions& o, engine::DynamicModel& model)
     const double d = times[k] - times[k - 1];
     spacing = spacing > 0 ? std::min(spacing, d) : d;
   }
-  const double step = EngineStep(o, model, spacing);
+  const double step = EngineStep(o, model, spacing, times.back(), "--frames");
   // The engine alone through the frames first (cheap beside the sampling): the box of every
   // frame's cells, and their largest count for the memory check.
   frep::Box3 box = EmptyBox();
@@ -646,7 +662,7 @@ int SampleSpaceTime(const DynamicSampleOptions& o, engine::DynamicModel& model)
     throw UserError("--space-time: " + std::to_string(nt) + " times is more than 100000");
   }
   const double dt = nt > 1 ? (t1 - t0) / static_cast<double>(nt - 1) : 0;
-  const double step = EngineStep(o, model, dt);
+  const double step = EngineStep(o, model, dt, t1, "--space-time");
   // The cell's cross-section at every time, as the engine has it (its operands moved, its
   // numbers evaluated), kept to sample once the box holding all of them is known.
   std::vector<geometry::PlacedShapePtr> shapes(static_cast<std::size_t>(nt));

@@ -240,6 +240,20 @@ std::vector<double> ParseFrames(const std::string& spec, const std::string& opti
   return engine::frameTimes(t0, t1, dt);
 }
 
+void CheckEngineSteps(
+  double start, double end, double step, const std::string& option, const std::string& hint)
+{
+  const double steps = (end - start) / step;
+  if (steps > engine::MaxEngineSteps)
+  {
+    std::ostringstream os;
+    os << option << ": " << step << " from the model's start " << start << " to " << end
+       << " gives " << steps << " engine steps, more than the limit of "
+       << static_cast<long long>(engine::MaxEngineSteps) << " (" << hint << ")";
+    throw UserError(os.str());
+  }
+}
+
 bool HasExtension(const std::string& path, const std::string& extension)
 {
   if (path.size() < extension.size())

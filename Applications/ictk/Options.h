@@ -74,6 +74,12 @@ std::array<std::int64_t, 3> ParseDims(const std::string& text);
 /// message starts with `option`, the name the range was given under (--frames, or `run`'s --time).
 std::vector<double> ParseFrames(const std::string& spec, const std::string& option = "--frames");
 
+/// The engine's steps from the model's `start` to `end`, at most `step` apart, checked against
+/// engine::MaxEngineSteps: above it a UserError "<option>: <step> from the model's start <start>
+/// to <end> gives <n> engine steps, more than the limit of 10000000 (<hint>)".
+void CheckEngineSteps(
+  double start, double end, double step, const std::string& option, const std::string& hint);
+
 /// True when `path` ends with `extension` (".vtp"), whatever the letters' case.
 bool HasExtension(const std::string& path, const std::string& extension);
 

@@ -259,16 +259,12 @@ int RunModel(const RunModelOptions& o)
        << source->GetStartTime() << ")";
     throw std::invalid_argument(os.str());
   }
-  // The engine's steps are set by --max-step: bounded as the frames are (ParseFrames).
-  constexpr double MaxEngineSteps = 1e7;
-  const double steps = (times.back() - source->GetStartTime()) / maxStep;
-  if (o.MaxStep > 0 && steps > MaxEngineSteps)
+  // The engine's steps are set by --max-step, else by the frames' spacing: bounded as the frames
+  // are (ParseFrames).
+  if (o.MaxStep > 0)
   {
-    std::ostringstream os;
-    os << "--max-step: " << o.MaxStep << " from the model's start " << source->GetStartTime()
-       << " to " << times.back() << " gives " << steps << " engine steps, more than the limit of "
-       << static_cast<long long>(MaxEngineSteps) << " (a larger --max-step?)";
-    throw std::invalid_argument(os.str());
+    CheckEngineSteps(
+      source->GetStartTime(), times.back(), o.MaxStep, "--max-step", "a larger --max-step?");
   }
   double engineSeconds = Seconds(loadStart), meshSeconds = 0;
 

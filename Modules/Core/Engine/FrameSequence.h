@@ -31,6 +31,9 @@ namespace ictk::engine
 
 /// More frames than anyone can look at: a range asking for them is a typo (a missing digit in DT).
 constexpr double MaxFrames = 1e6;
+/// The most engine steps a command runs to reach its last time (`--max-step`, or the step a
+/// command chooses): beyond it a run would not end in any reasonable time.
+constexpr double MaxEngineSteps = 1e7;
 
 /// The number of frames T0 + k DT in [T0, T1], with DT / 1000 of slack for rounding (T1 itself
 /// comes on top when DT does not divide the range); for refusing an absurd range before making it.
