@@ -285,6 +285,48 @@ TEST(Evaluators, IntervalsEnclosePointSamplesAndPruningKeepsValues)
   EXPECT_GT(cut, total / 50) << "cut " << cut << " of " << total;
 }
 
+TEST(Evaluators, IncrementalEvaluationMatchesFullEvaluationBitForBit)
+{
+  // Sequences of regions and points where each step changes a random subset of the axes (often
+  // one, sometimes none): the incremental evaluators reuse the instructions of the others and
+  // must give what a full evaluation gives, bounds, NaN flags and choices alike.
+  Random rng(11);
+  int reused = 0;
+  for (int n = 0; n < TreeCount; ++n)
+  {
+    const Expr e = randomTree(rng, 6, false) + Expr::parameter(0) * Expr::y();
+    const TapePtr tape = Tape::compile(e);
+    const std::vector<double> parameters{ rng.uniform(-2, 2) };
+    IntervalEvaluator full(tape, parameters);
+    IncrementalIntervalEvaluator incremental(tape, parameters);
+    PointEvaluator point(tape, parameters);
+    IncrementalPointEvaluator incrementalPoint(tape, parameters);
+    Region region;
+    std::array<double, 4> p{};
+    for (int step = 0; step < 24; ++step)
+    {
+      const int mask = step == 0 ? 15 : rng.index(16);
+      reused += mask != 15 ? 1 : 0;
+      for (int a = 0; a < 4; ++a)
+      {
+        if (mask & (1 << a))
+        {
+          const double c = rng.uniform(-3, 3), w = rng.uniform(0, step % 2 ? 0.05 : 1.5);
+          region.axes[a] = { c - w, c + w };
+          p[a] = rng.index(8) == 0 ? -0.0 : c;
+        }
+      }
+      const Interval a = full.eval(region), b = incremental.eval(region);
+      ASSERT_TRUE(sameDouble(a.lo, b.lo) && sameDouble(a.hi, b.hi)) << toString(e);
+      ASSERT_EQ(a.maybeNaN, b.maybeNaN) << toString(e);
+      ASSERT_EQ(full.choices(), incremental.choices()) << toString(e);
+      const double v = point.eval(p[0], p[1], p[2], p[3]);
+      ASSERT_TRUE(sameDouble(v, incrementalPoint.eval(p[0], p[1], p[2], p[3]))) << toString(e);
+    }
+  }
+  EXPECT_GT(reused, TreeCount * 20);
+}
+
 TEST(Evaluators, PruningCutsTheLosingBranchOfAUnion)
 {
   // max(sphere at -2, sphere at +2): near x = +2 only the second sphere matters.

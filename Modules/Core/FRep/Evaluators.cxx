@@ -484,16 +484,16 @@ Interval trigRange(bool isSin, const Interval& a)
     return { -1.0, 1.0, true }; // sin(inf) is NaN
   if (!(a.hi - a.lo < 2 * pi))
     return { -1.0, 1.0, a.maybeNaN };
-  double (*f)(double) =
-    isSin ? static_cast<double (*)(double)>(std::sin) : static_cast<double (*)(double)>(std::cos);
-  double lo = std::min(f(a.lo), f(a.hi));
-  double hi = std::max(f(a.lo), f(a.hi));
   const double maxAt = isSin ? pi / 2 : 0.0;
-  if (maxAt + 2 * pi * std::ceil((a.lo - maxAt) / (2 * pi)) <= a.hi)
-    hi = 1.0;
+  const bool hasMax = maxAt + 2 * pi * std::ceil((a.lo - maxAt) / (2 * pi)) <= a.hi;
   const double minAt = maxAt + pi;
-  if (minAt + 2 * pi * std::ceil((a.lo - minAt) / (2 * pi)) <= a.hi)
-    lo = -1.0;
+  const bool hasMin = minAt + 2 * pi * std::ceil((a.lo - minAt) / (2 * pi)) <= a.hi;
+  if (hasMax && hasMin)
+    return { -1.0, 1.0, a.maybeNaN }; // what widening and clamping give below, without libm
+  const double fLo = isSin ? std::sin(a.lo) : std::cos(a.lo);
+  const double fHi = isSin ? std::sin(a.hi) : std::cos(a.hi);
+  const double lo = hasMin ? -1.0 : std::min(fLo, fHi);
+  const double hi = hasMax ? 1.0 : std::max(fLo, fHi);
   Interval r = widen({ lo, hi, a.maybeNaN });
   return { std::max(r.lo, -1.0), std::min(r.hi, 1.0), r.maybeNaN };
 }
@@ -723,6 +723,146 @@ Interval IntervalEvaluator::eval(const Region& region)
     slots_[ins.out] = intervalOp(ins.op, slots_[ins.a], slots_[ins.b], slots_[ins.c], choices_[i]);
   }
   return slots_[tape_->outputs()[0]];
+}
+
+// ------------------------------------------------------------------------------------------------
+SsaCode::SsaCode(const Tape& tape)
+{
+  const std::uint32_t base = tape.temporaryBase();
+  const auto& instructions = tape.instructions();
+  valueCount = base + static_cast<std::uint32_t>(instructions.size());
+  // The value each slot holds at this point of the tape (register allocation reuses slots).
+  std::vector<std::uint32_t> valueInSlot(tape.slotCount());
+  for (std::uint32_t s = 0; s < tape.slotCount(); ++s)
+  {
+    valueInSlot[s] = s;
+  }
+  std::vector<std::uint8_t> axesOf(valueCount, 0);
+  for (std::uint32_t a = 0; a < 4; ++a)
+  {
+    axesOf[a] = static_cast<std::uint8_t>(1u << a);
+  }
+  code.reserve(instructions.size());
+  axes.reserve(instructions.size());
+  for (std::size_t i = 0; i < instructions.size(); ++i)
+  {
+    const Instruction& ins = instructions[i];
+    const auto v = static_cast<std::uint32_t>(base + i);
+    Instruction out{ ins.op, v, 0, 0, 0 };
+    const std::uint32_t operands[3] = { ins.a, ins.b, ins.c };
+    std::uint32_t* to[3] = { &out.a, &out.b, &out.c };
+    std::uint8_t mask = 0;
+    for (int k = 0; k < detail::arity(ins.op); ++k)
+    {
+      *to[k] = valueInSlot[operands[k]];
+      mask = static_cast<std::uint8_t>(mask | axesOf[*to[k]]);
+    }
+    axesOf[v] = mask;
+    valueInSlot[ins.out] = v;
+    code.push_back(out);
+    axes.push_back(mask);
+  }
+  output = valueInSlot[tape.outputs()[0]];
+}
+
+namespace
+{
+bool sameBits(double a, double b)
+{
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+bool sameInterval(const Interval& a, const Interval& b)
+{
+  return sameBits(a.lo, b.lo) && sameBits(a.hi, b.hi) && a.maybeNaN == b.maybeNaN;
+}
+} // namespace
+
+IncrementalIntervalEvaluator::IncrementalIntervalEvaluator(
+  TapePtr tape, const std::vector<double>& parameters)
+  : tape_(std::move(tape))
+  , ssa_(*tape_)
+  , values_(ssa_.valueCount)
+  , choices_(tape_->instructions().size(), Choice::Both)
+{
+  for (std::size_t i = 0; i < tape_->constants().size(); ++i)
+  {
+    const double v = tape_->constants()[i];
+    values_[tape_->constantBase() + i] = { v, v, std::isnan(v) };
+  }
+  std::vector<double> p;
+  loadParameters(*tape_, parameters, p);
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    values_[tape_->parameterBase() + i] = { p[i], p[i], std::isnan(p[i]) };
+  }
+}
+
+Interval IncrementalIntervalEvaluator::eval(const Region& region)
+{
+  unsigned changed = first_ ? ~0u : 0u;
+  for (int a = 0; a < 4; ++a)
+  {
+    if (!sameInterval(values_[a], region.axes[a]))
+    {
+      values_[a] = region.axes[a];
+      changed |= 1u << a;
+    }
+  }
+  // The first eval also computes the instructions of constants and parameters alone.
+  const std::uint8_t all = first_ ? 0xff : 0;
+  first_ = false;
+  const auto& code = ssa_.code;
+  for (std::size_t i = 0; i < code.size(); ++i)
+  {
+    if ((ssa_.axes[i] | all) & changed)
+    {
+      const Instruction& ins = code[i];
+      values_[ins.out] =
+        intervalOp(ins.op, values_[ins.a], values_[ins.b], values_[ins.c], choices_[i]);
+    }
+  }
+  return values_[ssa_.output];
+}
+
+IncrementalPointEvaluator::IncrementalPointEvaluator(
+  TapePtr tape, const std::vector<double>& parameters)
+  : tape_(std::move(tape))
+  , ssa_(*tape_)
+  , values_(ssa_.valueCount, 0.0)
+{
+  std::copy(
+    tape_->constants().begin(), tape_->constants().end(), values_.begin() + tape_->constantBase());
+  std::vector<double> p;
+  loadParameters(*tape_, parameters, p);
+  std::copy(p.begin(), p.end(), values_.begin() + tape_->parameterBase());
+}
+
+double IncrementalPointEvaluator::eval(double x, double y, double z, double t)
+{
+  const double p[4] = { x, y, z, t };
+  unsigned changed = first_ ? ~0u : 0u;
+  for (int a = 0; a < 4; ++a)
+  {
+    if (!sameBits(values_[a], p[a]))
+    {
+      values_[a] = p[a];
+      changed |= 1u << a;
+    }
+  }
+  const std::uint8_t all = first_ ? 0xff : 0;
+  first_ = false;
+  double* s = values_.data();
+  const auto& code = ssa_.code;
+  for (std::size_t i = 0; i < code.size(); ++i)
+  {
+    if ((ssa_.axes[i] | all) & changed)
+    {
+      const Instruction& ins = code[i];
+      s[ins.out] = applyScalar<double>(ins.op, s[ins.a], s[ins.b], s[ins.c]);
+    }
+  }
+  return s[ssa_.output];
 }
 
 // ------------------------------------------------------------------------------------------------

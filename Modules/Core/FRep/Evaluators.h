@@ -104,6 +104,56 @@ private:
   std::vector<Choice> choices_;
 };
 
+/// The tape in single-assignment form for the incremental evaluators below: every instruction
+/// writes a value of its own (leaves first, then one per instruction), so a value stays valid
+/// until its inputs change; with the axes each instruction depends on.
+struct SsaCode
+{
+  explicit SsaCode(const Tape& tape);
+  std::vector<Instruction> code;  ///< out and operands are value ids
+  std::vector<std::uint8_t> axes; ///< per instruction: bit a set when it depends on Axis(a)
+  std::uint32_t valueCount = 0;
+  std::uint32_t output = 0; ///< the value id of the first output
+};
+
+/// The same enclosures and choices as IntervalEvaluator, for regions that often differ from the
+/// last one in some axes only (the pieces of one ray along a coordinate axis, neighbouring rays
+/// of an axis-aligned view): instructions that depend on no axis that changed keep their value
+/// and choice from the last eval. Each instruction keeps a value of its own (no register reuse),
+/// so it is for tapes that are evaluated many times in a row, not for pruned tapes of a few uses.
+class IncrementalIntervalEvaluator
+{
+public:
+  explicit IncrementalIntervalEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  Interval eval(const Region& region);
+  const std::vector<Choice>& choices() const { return choices_; }
+  TapePtr simplified() const { return tape_->simplify(choices_); }
+  const TapePtr& tape() const { return tape_; }
+
+private:
+  TapePtr tape_;
+  SsaCode ssa_;
+  std::vector<Interval> values_;
+  std::vector<Choice> choices_;
+  bool first_ = true;
+};
+
+/// The same values as PointEvaluator, reusing the instructions that depend on no coordinate
+/// that changed since the last eval (the points of one ray along a coordinate axis).
+class IncrementalPointEvaluator
+{
+public:
+  explicit IncrementalPointEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  double eval(double x, double y, double z = 0, double t = 0);
+  const TapePtr& tape() const { return tape_; }
+
+private:
+  TapePtr tape_;
+  SsaCode ssa_;
+  std::vector<double> values_;
+  bool first_ = true;
+};
+
 /// Value and gradient (d/dx, d/dy, d/dz, d/dt) by forward-mode differentiation.
 struct ValueGradient
 {

@@ -24,7 +24,6 @@ namespace ictk::render
 
 using frep::Box3;
 using frep::Interval;
-using frep::IntervalEvaluator;
 using frep::Point3;
 using frep::TapePtr;
 
@@ -108,8 +107,12 @@ private:
   TapePtr tape_;
   const std::vector<double>& parameters_;
   double time_;
-  IntervalEvaluator interval_;
-  std::optional<frep::PointEvaluator> point_;
+  // Incremental: the pieces of one pixel's ray, and neighbouring rays, differ in some
+  // coordinates only when the rays are parallel to an axis (an orthographic view along it, as
+  // libfive's heightmap view), and then the instructions of the others keep their values;
+  // otherwise the reuse costs a test per instruction.
+  frep::IncrementalIntervalEvaluator interval_;
+  std::optional<frep::IncrementalPointEvaluator> point_;
   std::optional<frep::GradientEvaluator> gradient_;
 };
 
@@ -216,6 +219,7 @@ struct Workspace
   std::unique_ptr<detail::Stage> root; // the full evaluation: every tile starts with it
   std::unique_ptr<detail::Painter> painter;
   std::vector<std::uint8_t> done; // the current tile's pixels that found their surface
+  std::size_t doneCount = 0;      // how many
   /// Per pixel of the tile: the depth of the first piece that was left unresolved (NaN: none).
   std::vector<double> unresolvedAt;
   Rect tile{ 0, 0, 0, 0 };
@@ -317,6 +321,7 @@ private:
     ws.tile = tile;
     const std::size_t pixels = static_cast<std::size_t>(tile.i1 - tile.i0) * (tile.j1 - tile.j0);
     ws.done.assign(pixels, 0);
+    ws.doneCount = 0;
     ws.unresolvedAt.assign(pixels, std::numeric_limits<double>::quiet_NaN());
     if (!(far_ > near_))
     {
@@ -372,8 +377,12 @@ private:
   /// are distances along rays of |direction| >= 1, bound their s from above).
   bool remaining(Workspace& ws, Rect& r, double& limit) const
   {
-    Rect p{ r.i1, r.j1, r.i0, r.j0 };
     limit = limited_ ? 0 : std::numeric_limits<double>::infinity();
+    if (ws.doneCount == 0 && !limited_)
+    {
+      return true; // nothing found yet in this tile: every pixel remains
+    }
+    Rect p{ r.i1, r.j1, r.i0, r.j0 };
     for (int j = r.j0; j < r.j1; ++j)
     {
       for (int i = r.i0; i < r.i1; ++i)
@@ -468,7 +477,11 @@ private:
     {
       return;
     }
-    std::unique_ptr<detail::Stage> narrow = stage.narrowed();
+    // A node whose children are single pixels keeps its tape: a tape simplified for it would
+    // serve a few evaluations of at most four rays, and building it costs more than they save
+    // (7% of the instructions of render-sphere-gyroid).
+    const bool pixelsNext = r.i1 - r.i0 <= 2 && r.j1 - r.j0 <= 2;
+    std::unique_ptr<detail::Stage> narrow = pixelsNext ? nullptr : stage.narrowed();
     detail::Stage& next = narrow ? *narrow : stage;
     const int across = std::max(r.i1 - r.i0, r.j1 - r.j0);
     if (s1 - s0 > across * footprint(s1))
@@ -543,6 +556,15 @@ private:
       hit(ws, *ws.root, ray, u, u, true); // nothing was found within a leaf behind it
       return true;
     }
+    const double m = 0.5 * (a + b);
+    const bool divisible = m > a && m < b;
+    const double leafLength = std::max(footprint(b), tolerance_);
+    if (divisible && (b - a) * ray.length > leafLength && (b - a) * ray.length <= 2 * leafLength)
+    {
+      // At most two leaves: bounding the whole first is wasted when it is not excluded (two thirds
+      // of such pieces on render-sphere-gyroid), so the halves are bounded directly.
+      return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
+    }
     Point3 lo = ray.at(a), hi = ray.at(b);
     for (int k = 0; k < 3; ++k)
     {
@@ -557,9 +579,7 @@ private:
     }
     // The tape is not simplified again along one pixel's ray: building a tape there costs more
     // than the instructions it removes (9% of the time of render-sphere-gyroid-1024).
-    const double m = 0.5 * (a + b);
-    const bool divisible = m > a && m < b;
-    if (divisible && (b - a) * ray.length > std::max(footprint(b), tolerance_))
+    if (divisible && (b - a) * ray.length > leafLength)
     {
       return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
     }
@@ -591,14 +611,21 @@ private:
     const double fb = f(ws, stage, ray, b);
     if (fb >= 0)
     {
-      double inside = b;
-      auto g = [&](double s)
+      // One pointer captured, so that std::function keeps it without allocating.
+      struct Probe
       {
-        ++ws.counts.points;
-        const double value = stage.value(ray.at(s));
+        Workspace& ws;
+        detail::Stage& stage;
+        const Ray& ray;
+        double inside;
+      } probe{ ws, stage, ray, b };
+      auto g = [p = &probe](double s)
+      {
+        ++p->ws.counts.points;
+        const double value = p->stage.value(p->ray.at(s));
         if (value >= 0)
         {
-          inside = std::min(inside, s);
+          p->inside = std::min(p->inside, s);
           return value;
         }
         return std::isnan(value) ? -std::numeric_limits<double>::min() : value;
@@ -607,7 +634,7 @@ private:
       refine.timeTolerance = tolerance_ / ray.length;
       refine.maxIterations = 100;
       const double root = frep::refineRoot(g, a, std::isnan(fa) ? -1.0 : fa, b, fb, refine);
-      found(ws, stage, ray, root, inside);
+      found(ws, stage, ray, root, probe.inside);
       return true;
     }
     const double m = 0.5 * (a + b);
@@ -648,7 +675,9 @@ private:
   bool hit(
     Workspace& ws, detail::Stage& stage, const Ray& ray, double s, double inside, bool unresolved)
   {
-    done(ws, ray.i, ray.j) = 1;
+    std::uint8_t& d = done(ws, ray.i, ray.j);
+    ws.doneCount += d ? 0 : 1;
+    d = 1;
     const Paint paint = ws.painter && !unresolved ? ws.painter->at(ray.at(inside)) : Paint{};
     // A solid cut by its box shows the cut flat, lit by the face's normal (its gradient there
     // belongs to no surface: on a tie of a min or max it even flips from pixel to pixel).

@@ -16,16 +16,22 @@
 //   2. A node whose interval excludes 0 from above (f < 0 on the whole piece, or NaN) holds no
 //      point of the solid and is dropped. Otherwise the tape is simplified for the piece (min,
 //      max and select whose operand is decided there are cut: IntervalEvaluator::simplified,
-//      the same pruning as FRep/Render.h), and the node is split with the shorter tape: in depth
-//      (front half first) while the piece is deeper than it is wide, else as a quadtree over
-//      the rectangle. Pixels that found their surface are skipped by the nodes behind them.
+//      the same pruning as FRep/Render.h; not for a node whose children are single pixels,
+//      where building the tape costs more than it saves), and the node is split with the
+//      shorter tape: in depth (front half first) while the piece is deeper than it is wide,
+//      else as a quadtree over the rectangle. Pixels that found their surface are skipped by
+//      the nodes behind them.
 //   3. At one pixel the ray, clipped to the model's box, is cut in halves in depth, each checked
 //      by intervals (with the tape of the last node: simplifying per piece of one ray costs more
-//      than it saves), front first, down to a leaf no longer than the pixel's footprint at that
-//      depth. In a leaf f is evaluated at both ends: a sign change is refined by Illinois
+//      than it saves; a piece of at most two leaves is not checked whole, only its halves),
+//      front first, down to a leaf no longer than the pixel's footprint at that depth. In a
+//      leaf f is evaluated at both ends: a sign change is refined by Illinois
 //      (FRep/RootFinding.h refineRoot) to the depth tolerance; two negative ends under an
 //      interval that does not exclude 0 mean a feature may hide inside, so the leaf is halved
-//      again (intervals and samples) down to the depth tolerance.
+//      again (intervals and samples) down to the depth tolerance. The evaluators are
+//      incremental (FRep/Evaluators.h): successive pieces of one ray differ in z alone when the
+//      rays are parallel to z (an orthographic view along it), and then only the instructions
+//      that depend on z run again; the values are those of a full evaluation, bit for bit.
 //   4. The hit is shaded from the analytic gradient (Lambert with an ambient term, lit by a
 //      headlight, both faces lit) in the model's colour (see RayCastOptions).
 //
