@@ -9,8 +9,10 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <utility>
+#include <variant>
 
 namespace ictk::engine
 {
@@ -113,6 +115,8 @@ CoherenceStats& CoherenceStats::operator+=(const CoherenceStats& o)
   computed += o.computed;
   moved += o.moved;
   reused += o.reused;
+  blocksContoured += o.blocksContoured;
+  blocksReused += o.blocksReused;
   seconds += o.seconds;
   return *this;
 }
@@ -231,7 +235,21 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
       cellOptions.progress = nullptr;
       Kept kept;
       kept.version = state.shapeVersion;
+      const complex::Cell& made = one.cell(localId);
+      if (options_.coherent && found != kept_.end() && made.dimension == 3 &&
+        std::holds_alternative<complex::ImplicitGeometry>(made.geometry))
+      {
+        kept.surface = found->second.surface ? found->second.surface
+                                             : std::make_shared<discretize::SurfaceMemory>();
+        kept.surface->setLastCall({});
+        cellOptions.surfaceMemory = kept.surface.get();
+      }
       kept.local = complex::discretizeCell(one, localId, cellOptions);
+      if (kept.surface)
+      {
+        frame.blocksContoured += kept.surface->lastCall().blocksContoured;
+        frame.blocksReused += kept.surface->lastCall().blocksReused;
+      }
       // Attributes are evaluated where the points are, every frame; the point arrays that come
       // with an explicit geometry (a skinned mesh's dominant joint) go with the points.
       const auto* given = std::get_if<complex::ExplicitGeometry>(&one.cell(localId).geometry);
