@@ -268,10 +268,7 @@ public:
   void values(
     const double* x, const double* y, const double* z, double* out, std::size_t n) override
   {
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      out[i] = prepared_->value({ x[i], y[i], z[i] });
-    }
+    prepared_->values(x, y, z, out, n);
   }
   Interval bound(const Box3& box) override { return prepared_->bound(box); }
   double gradient(const frep::Point3& p, frep::Point3& grad) override

@@ -508,6 +508,80 @@ double Prepared::value(Vec3 w) const
   return v;
 }
 
+void Prepared::values(
+  const double* x, const double* y, const double* z, double* out, std::size_t n) const
+{
+  std::fill(out, out + n, -Inf);
+  std::vector<double> zeros;
+  if (flat)
+  {
+    zeros.assign(n, 0.0);
+    z = zeros.data();
+  }
+  std::vector<double> part(n);
+  for (const auto& pp : parts)
+  {
+    if (pp.dim >= 2)
+    {
+      partValues(pp, x, y, z, part.data(), n);
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        out[i] = std::max(out[i], part[i]);
+      }
+    }
+  }
+}
+
+void Prepared::partValues(const PreparedPart& pp, const double* x, const double* y, const double* z,
+  double* out, std::size_t n) const
+{
+  const ShapePart& p = *pp.part;
+  if (p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union)
+  {
+    std::vector<double> fb(n);
+    pp.a->values(x, y, z, out, n);
+    pp.b->values(x, y, z, fb.data(), n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      out[i] = p.kind == ShapePart::Kind::Union ? std::max(out[i], fb[i])
+                                                : blendUnion(out[i], fb[i], p.amount);
+    }
+    return;
+  }
+  if (p.kind != ShapePart::Kind::Field)
+  {
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      out[i] = partValue(pp, { x[i], y[i], z[i] });
+    }
+    return;
+  }
+  // The local points, then the field at all of them in one call.
+  std::vector<double> local(3 * n);
+  double* lx = local.data();
+  double* ly = lx + n;
+  double* lz = ly + n;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Vec3 l = pp.toLocal.apply({ x[i], y[i], z[i] });
+    lx[i] = l[0];
+    ly[i] = l[1];
+    lz[i] = pp.dim <= 2 ? 0.0 : l[2];
+  }
+  pp.eval->values(lx, ly, lz, out, n);
+  const int axes = pp.dim == 2 ? 2 : 3;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    double f = std::isnan(out[i]) ? -Inf : out[i];
+    const double l[3] = { lx[i], ly[i], lz[i] };
+    for (int a = 0; a < axes; ++a)
+    {
+      f = std::min({ f, l[a] - pp.domain.lo[a], pp.domain.hi[a] - l[a] });
+    }
+    out[i] = f;
+  }
+}
+
 Interval Prepared::partBound(const PreparedPart& pp, const Box3& w) const
 {
   const ShapePart& p = *pp.part;

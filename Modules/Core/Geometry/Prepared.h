@@ -151,6 +151,12 @@ struct Prepared
   double partValue(const PreparedPart& pp, Vec3 w) const;
   /// The world field (>= 0 inside; the max over the 2D/3D parts).
   double value(Vec3 w) const;
+  /// value() at n points given as coordinate arrays, a Field part's field evaluated in one
+  /// FieldEvaluator::values call (batched, several times cheaper than point by point; the values
+  /// may differ from value()'s in the last bits, as the batch and gradient evaluators do).
+  void values(const double* x, const double* y, const double* z, double* out, std::size_t n) const;
+  void partValues(const PreparedPart& pp, const double* x, const double* y, const double* z,
+    double* out, std::size_t n) const;
   Interval partBound(const PreparedPart& pp, const Box3& w) const;
   /// An enclosure of value() over a world box.
   Interval bound(Box3 w) const;
