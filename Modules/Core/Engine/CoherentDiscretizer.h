@@ -127,6 +127,12 @@ private:
     /// From the cell's second meshing on (its shape changed once, so it may again): the work of
     /// its last meshing, for the next one. Cells that never change do not pay for it.
     std::shared_ptr<discretize::SurfaceMemory> surface;
+    /// Keeping blocks costs a copy of each (about 5% of a meshing): after a meshing with a
+    /// memory that reused nothing (a field that changes everywhere), the next 2^misses - 1
+    /// meshings go without one, then it is tried again. Only the work done changes, never the
+    /// mesh.
+    std::uint32_t misses = 0;
+    std::uint32_t skip = 0;
   };
   CoherenceOptions options_;
   double featureSize_ = 0;
