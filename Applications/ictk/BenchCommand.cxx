@@ -914,11 +914,17 @@ std::vector<Result> Andyhausen(const std::string& name, double t1, int steps)
     r.details["cells_computed"] = timing->computed;
     r.details["cells_moved"] = timing->moved;
     r.details["cells_reused"] = timing->reused;
+    r.details["blocks_contoured"] = timing->blocksContoured;
+    r.details["blocks_reused"] = timing->blocksReused;
     r.details["instances"] = timing->instances;
     if (!isFull)
     {
       r.details["full_remesh_seconds"] = Median(full.seconds);
       r.details["coherence_speedup"] = Median(full.seconds) / r.seconds;
+      // CPU time is the fair figure on a shared machine: the two runs may get different
+      // shares of the cores.
+      r.details["full_remesh_cpu_seconds"] = Median(full.cpuSeconds);
+      r.details["coherence_speedup_cpu"] = Median(full.cpuSeconds) / Median(timing->cpuSeconds);
       r.details["mesh_speedup"] = full.meshSeconds / timing->meshSeconds;
     }
     results.push_back(std::move(r));

@@ -59,6 +59,8 @@ DynamicRunTiming TimeDynamicRun(const std::string& path, double t1, int steps, i
     out.computed = mesher.total().computed;
     out.moved = mesher.total().moved;
     out.reused = mesher.total().reused;
+    out.blocksContoured = mesher.total().blocksContoured;
+    out.blocksReused = mesher.total().blocksReused;
     out.featureSize = mesher.featureSize();
     out.instances = instances;
   }

@@ -19,6 +19,9 @@ struct DynamicRunTiming
   std::size_t frames = 0;
   std::size_t points = 0; ///< mesh points over all frames of a run
   std::size_t computed = 0, moved = 0, reused = 0;
+  /// Blocks (8^3 grid cells) of the computed cells' surfaces contoured and copied from the
+  /// cell's previous meshing (CoherenceStats).
+  std::size_t blocksContoured = 0, blocksReused = 0;
   double featureSize = 0;
   std::vector<std::string> instances; ///< the instances met, in order
 };

@@ -646,3 +646,108 @@ TEST(DiscretizeSurface, RandomLatticesAreClosedManifolds)
   }
   EXPECT_GT(nonEmpty, 250);
 }
+
+namespace
+{
+
+/// An axis-aligned cube of half side 0.49 centred at (cx, 1, 1), as min of its slabs: its interval
+/// bounds over a box are exact (up to outward rounding), so the octree's decisions can be counted
+/// by hand.
+Expr cubeAt(const Expr& cx)
+{
+  const auto slab = [](const Expr& v, const Expr& c)
+  {
+    return 0.49 - frep::abs(v - c);
+  };
+  return frep::min(frep::min(slab(Expr::x(), cx), slab(Expr::y(), Expr::constant(1))),
+    slab(Expr::z(), Expr::constant(1)));
+}
+
+} // namespace
+
+// Time coherence below the cell (SurfaceMemory): two cubes, A at x = 1 + 0.001 p (p a tape
+// parameter) and B at x = 5, as max(A, B) over [0, 6] x [0, 2] x [0, 2] at h = 1/16. The tasks
+// are nodes of 32 cells (2 units) and the blocks 8 cells (0.5 units), cell c spanning
+// [(c - 1) h, c h]: only the tasks at x cells 0..31 (A) and 64..95 (B) may hold the surface.
+// Each cube crosses blocks 1..3 of its task along each axis (its faces 0.49 from the centre;
+// block 0 and the far ones are outside), 27 blocks of which the centre one is inside: 26 blocks
+// a cube. In B's task A's interval lies below B's, so the pruned tape is B's alone and does not
+// read p: when p changes, that task is copied whole and only A's 26 blocks are contoured.
+TEST(DiscretizeSurface, MemoryReusesWhatTheParameterCannotReach)
+{
+  const auto tape = frep::Tape::compile(
+    frep::max(cubeAt(1.0 + 0.001 * Expr::parameter(0)), cubeAt(Expr::constant(5))));
+  const Box3 box{ { 0, 0, 0 }, { 6, 2, 2 } };
+  SurfaceMemory memory;
+  auto run = [&](double p, int threads, SurfaceMemory* m)
+  {
+    SurfaceOptions options;
+    options.featureSize = 1.0 / 16;
+    options.threads = threads;
+    options.memory = m;
+    return contourSurface(*frep::tapeField(tape, 0, { p }), box, options);
+  };
+  struct Expected
+  {
+    double p;
+    std::size_t contoured, reused, tasksReused;
+  };
+  // First call: nothing kept. Then p changes: B's task is reused. Then p stays: everything is.
+  // Then p = 5 (A's centre at 1.005, the same blocks): A's blocks again, but for three. In A's
+  // blocks at x in [0.9375, 1.4375] and y in [1.4375, 1.9375] (block coordinates 16 and 24),
+  // A's y slab is at most 0.49 - 0.4375 = 0.0525 and its x slab at least 0.49 - (1.4375 - c):
+  // 0.0535 for c = 1.001, 0.0575 for c = 1.005, so min(x slab, y slab) is the y slab there and
+  // the pruned tape does not read p (for c = 1, 0.0525 against 0.0525 prunes nothing: the second
+  // call contours them). Those three blocks (z blocks 8, 16, 24) keep their mesh.
+  const Expected calls[] = { { 0, 52, 0, 0 }, { 1, 26, 26, 1 }, { 1, 0, 52, 2 }, { 5, 23, 29, 1 } };
+  for (const Expected& e : calls)
+  {
+    const SurfaceMesh kept = run(e.p, 0, &memory);
+    const SurfaceMesh fresh = run(e.p, 1, nullptr);
+    ASSERT_GT(fresh.triangles.size(), 100u);
+    // The same mesh, bit for bit, as contouring from scratch.
+    EXPECT_TRUE(kept.points == fresh.points) << "p = " << e.p;
+    EXPECT_TRUE(kept.triangles == fresh.triangles) << "p = " << e.p;
+    const SurfaceReuse& r = memory.lastCall();
+    EXPECT_EQ(r.tasks, 2u) << "p = " << e.p;
+    EXPECT_EQ(r.blocksContoured, e.contoured) << "p = " << e.p;
+    EXPECT_EQ(r.blocksReused, e.reused) << "p = " << e.p;
+    EXPECT_EQ(r.tasksReused, e.tasksReused) << "p = " << e.p;
+  }
+  // The counts do not depend on the threads either.
+  SurfaceMemory one;
+  run(0, 1, &one);
+  const SurfaceMesh single = run(1, 1, &one);
+  EXPECT_EQ(one.lastCall().blocksReused, 26u);
+  EXPECT_TRUE(single.points == run(1, 2, nullptr).points);
+  // Another grid forgets what was kept.
+  SurfaceOptions finer;
+  finer.featureSize = 1.0 / 32;
+  finer.memory = &memory;
+  contourSurface(*frep::tapeField(tape, 0, { 1.0 }), box, finer);
+  EXPECT_EQ(memory.lastCall().blocksReused, 0u);
+  EXPECT_GT(memory.lastCall().blocksContoured, 0u);
+}
+
+// A field that changes everywhere (a parameter in a term no interval can prune, as in an
+// R-function) reuses nothing: its mesh really changes in every block.
+TEST(DiscretizeSurface, MemoryReusesNothingOfAFieldThatChangesEverywhere)
+{
+  const Expr r = 1.0 - Expr::x() * Expr::x() - Expr::y() * Expr::y() - Expr::z() * Expr::z();
+  const auto moving = frep::Tape::compile(r + 0.01 * frep::sin(Expr::parameter(0)));
+  const Box3 box{ { -1.5, -1.5, -1.5 }, { 1.5, 1.5, 1.5 } };
+  SurfaceMemory memory;
+  SurfaceOptions options;
+  options.featureSize = 0.05;
+  options.memory = &memory;
+  contourSurface(*frep::tapeField(moving, 0, { 0.0 }), box, options);
+  const std::size_t all = memory.lastCall().blocksContoured;
+  EXPECT_GT(all, 0u);
+  const SurfaceMesh kept = contourSurface(*frep::tapeField(moving, 0, { 0.5 }), box, options);
+  EXPECT_EQ(memory.lastCall().blocksContoured, all);
+  EXPECT_EQ(memory.lastCall().blocksReused, 0u);
+  options.memory = nullptr;
+  const SurfaceMesh fresh = contourSurface(*frep::tapeField(moving, 0, { 0.5 }), box, options);
+  EXPECT_TRUE(kept.points == fresh.points);
+  EXPECT_TRUE(kept.triangles == fresh.triangles);
+}

@@ -6,6 +6,7 @@
 #include "Discretize/Mesh.h"
 #include "Engine/CoherentDiscretizer.h"
 #include "Engine/DynamicModel.h"
+#include "Lang/Icm.h"
 
 #include <gtest/gtest.h>
 
@@ -221,11 +222,16 @@ TEST(EngineCoherence, AndyhausenCoherentEqualsFullRemeshing)
     }
     const complex::ComplexMesh ma = coherent.discretize(a);
     const complex::ComplexMesh mb = full.discretize(b);
-    ExpectSameMeshes(ma, mb, 1e-9, t);
+    // Identical, bit for bit: kept meshes, moved meshes and the liquid's blocks kept from its
+    // previous meshing are what meshing from scratch gives.
+    ExpectSameMeshes(ma, mb, 0.0, t);
     if (k > 0)
     {
       // The barrel never moves nor changes: its first mesh serves every frame. The liquid's
-      // noise changes its phase every frame (thesis L3627-L3633): it is meshed again.
+      // noise changes its phase every frame (thesis L3627-L3633): it is meshed again, and as
+      // its '&' is an R-function (f1 + f2 - sqrt(f1^2 + f2^2)), the noise term reaches every
+      // block of it: its walls' vertices move too, and no block of it can be reused but those
+      // known to be inside (which never evaluate the field).
       EXPECT_EQ(WorkOf(coherent, "Barrel"), CellWork::Reused) << "t = " << t;
       EXPECT_EQ(WorkOf(coherent, "Liquid"), CellWork::Computed) << "t = " << t;
     }
@@ -237,6 +243,99 @@ TEST(EngineCoherence, AndyhausenCoherentEqualsFullRemeshing)
   EXPECT_GE(s.reused, 20u);
   EXPECT_GT(s.moved, 0u);
   EXPECT_LT(s.computed, s.cells() / 2);
+}
+
+// A pool like Andyhausen's liquid, but cut by min instead of HyperFun's '&': the noise on its
+// top, whose phase a[1] = 2t changes every frame, is pruned away by interval arithmetic
+// wherever the top cannot be the nearer side (min's other operand always smaller), so the
+// blocks of its walls and bottom have pruned tapes that do not read a[1].
+const char* kPool = R"(
+name = POOL;
+TIMESPANS { film : TIMESPAN(0, 2); }
+CELLS {
+  Pool {
+    type = F-CELL;
+    shape = hyperfun {
+      pool(x[3], a[1])
+      {
+        pool = min(-0.5 - x[2] + 0.05 * sin(a[1]) * sin(4 * x[1]) * sin(4 * x[3]),
+          1 - x[1]^2 - x[3]^2);
+      }
+    }
+    dim = 3D;
+    domain = { -1.1, -2, -1.1, 1.1, -0.25, 1.1 };
+    parameters {
+      phase : REAL(0.0);
+    }
+    REACTIONS {
+      update(REAL globalT, REAL localT, REAL lifeT, REAL dt)
+      {
+        phase = 2.0 * globalT;
+        setShapeParameter(Pool, "a[1]", phase);
+      }
+    }
+  }
+  Ball {
+    type = F-CELL;
+    shape = hyperfun {
+      ball(x[3], a[1]) { ball = 0.09 - x[1]^2 - x[2]^2 - x[3]^2; }
+    }
+    dim = 3D;
+    domain = { -0.3, -0.3, -0.3, 0.3, 0.3, 0.3 };
+  }
+}
+K { CELLS { Pool Ball; } }
+)";
+
+// Coherence below the cell: the pool is meshed again in every frame (its shape version changes),
+// but from its second meshing on it keeps its blocks, and the blocks whose pruned field does not
+// read the phase (the walls and the bottom) are copied; the meshes stay those of a full
+// re-meshing, bit for bit.
+TEST(EngineCoherence, AParameterChangingCellReusesTheBlocksItCannotReach)
+{
+  DynamicModel a(lang::readIcm(kPool, "pool.icm"));
+  const DynamicModel& b = a;
+  a.start();
+  CoherenceOptions options;
+  options.featureSize = 0.05;
+  CoherentDiscretizer coherent(options);
+  options.coherent = false;
+  CoherentDiscretizer full(options);
+  std::size_t visited = 0;
+  for (int k = 0; k <= 10; ++k)
+  {
+    const double t = 0.1 * k;
+    if (t > a.time())
+    {
+      a.advanceTo(t, 0.1);
+    }
+    const complex::ComplexMesh ma = coherent.discretize(a);
+    const complex::ComplexMesh mb = full.discretize(b);
+    ExpectSameMeshes(ma, mb, 0.0, t);
+    const engine::CoherenceStats& s = coherent.lastFrame();
+    if (k == 0)
+    {
+      // Nothing is kept at the first meshing of a cell.
+      EXPECT_EQ(s.computed, 2u);
+      EXPECT_EQ(s.blocksContoured + s.blocksReused, 0u);
+      continue;
+    }
+    EXPECT_EQ(WorkOf(coherent, "Pool"), CellWork::Computed) << "t = " << t;
+    EXPECT_EQ(WorkOf(coherent, "Ball"), CellWork::Reused) << "t = " << t;
+    if (k == 1)
+    {
+      // The second meshing keeps its blocks, with nothing to reuse yet.
+      EXPECT_EQ(s.blocksReused, 0u);
+      EXPECT_GT(s.blocksContoured, 0u);
+      visited = s.blocksContoured;
+      continue;
+    }
+    // The phase changes every frame: the top's blocks are contoured again, the rest copied.
+    EXPECT_GT(s.blocksContoured, 0u) << "t = " << t;
+    EXPECT_GT(s.blocksReused, s.blocksContoured) << "t = " << t;
+    EXPECT_EQ(s.blocksContoured + s.blocksReused, visited) << "t = " << t;
+    EXPECT_EQ(full.lastFrame().blocksContoured + full.lastFrame().blocksReused, 0u);
+  }
 }
 
 // Thesis 5.1 (ch5_1_disk_rectangle.icm): in K3 the rectangle rests, the disk moves, and the chord,

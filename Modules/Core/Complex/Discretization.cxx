@@ -179,6 +179,7 @@ void discretizeImplicit(
       discretize::SurfaceOptions surface;
       surface.featureSize = o.featureSize;
       surface.threads = o.threads;
+      surface.memory = o.surfaceMemory;
       out.surface = discretize::contourSurface(*intersection(g.inside), g.bounds, surface);
       break;
     }
@@ -314,6 +315,7 @@ ComplexMesh discretizeComplex(const Complex& complex, const DiscretizationOption
 {
   ComplexMesh mesh;
   DiscretizationOptions o = options;
+  o.surfaceMemory = nullptr;
   if (!(o.featureSize > 0))
   {
     o.featureSize = defaultFeatureSize(complex);

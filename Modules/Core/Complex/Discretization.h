@@ -7,6 +7,7 @@
 
 #include "Complex/Complex.h"
 #include "Discretize/Mesh.h"
+#include "Discretize/Surface.h"
 #include "FRep/Progress.h"
 
 #include <functional>
@@ -28,6 +29,11 @@ struct DiscretizationOptions
   /// discretizeComplex: only these cells (a selection, or one MPI rank's share); empty = every
   /// cell. Their meshes equal those of a whole discretisation, attributes included.
   std::vector<CellId> cells;
+  /// discretizeCell of a 3D implicit cell: the work of the previous discretisation of the same
+  /// cell, reused where its field did not change, and this one's kept for the next
+  /// (discretize::SurfaceMemory; time-coherent re-meshing). The mesh is the same without it.
+  /// discretizeComplex ignores it (one memory is for one cell).
+  discretize::SurfaceMemory* surfaceMemory = nullptr;
 };
 
 /// The discretisation of one cell. Exactly one of the members is filled, by dimension: points

@@ -19,7 +19,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace ictk::discretize
@@ -144,7 +146,38 @@ void emitQuads(Block& block, std::vector<std::unique_ptr<Block>>& blocks, const 
   }
 }
 
+bool sameGrid(const SurfaceMemory::State& kept, const Layout& layout, bool sharp)
+{
+  return kept.valid && kept.lo == layout.lo && kept.h == layout.h && kept.pin == layout.pin &&
+    kept.sharp == sharp;
+}
+
+/// The previous call's tasks by place.
+std::map<std::pair<std::array<int, 3>, int>, std::size_t> tasksByPlace(
+  const SurfaceMemory::State& kept)
+{
+  std::map<std::pair<std::array<int, 3>, int>, std::size_t> index;
+  for (std::size_t t = 0; t < kept.tasks.size(); ++t)
+  {
+    index.emplace(std::make_pair(kept.tasks[t].origin, kept.tasks[t].size), t);
+  }
+  return index;
+}
+
 } // namespace
+
+SurfaceMemory::SurfaceMemory()
+  : state_(std::make_unique<State>())
+{
+}
+
+SurfaceMemory::~SurfaceMemory() = default;
+
+void SurfaceMemory::clear()
+{
+  *state_ = State{};
+  last_ = {};
+}
 
 SurfaceMesh contourSurface(
   const frep::Field& field, const frep::Box3& box, const SurfaceOptions& options)
@@ -157,6 +190,18 @@ SurfaceMesh contourSurface(
     auto ev = field.evaluator();
     collectTasks(*ev, layout, { 0, 0, 0 }, layout.rootCells, tasks);
   }
+
+  // Time coherence: the previous call's tasks, when they were made on this grid, and this call's.
+  SurfaceMemory* memory = options.memory;
+  if (memory && !sameGrid(memory->state(), layout, options.sharpFeatures))
+  {
+    memory->clear();
+  }
+  const SurfaceMemory::State* before = memory ? &memory->state() : nullptr;
+  const auto previousTasks =
+    before ? tasksByPlace(*before) : std::map<std::pair<std::array<int, 3>, int>, std::size_t>{};
+  std::vector<KeptTask> keptTasks(memory ? tasks.size() : 0);
+  std::vector<SurfaceReuse> taskReuse(memory ? tasks.size() : 0);
 
   std::vector<std::vector<std::unique_ptr<Block>>> taskBlocks(tasks.size());
   struct ThreadState
@@ -186,7 +231,55 @@ SurfaceMesh contourSurface(
       narrowed = state.evaluator->narrowed(layout.clippedBox(task.origin, task.size));
     }
     FieldEvaluator& ev = narrowed ? *narrowed : *state.evaluator;
-    descend(ev, layout, task.origin, task.size, task.knownInside, *state.contourer, taskBlocks[t]);
+    if (!memory)
+    {
+      descend(
+        ev, layout, task.origin, task.size, task.knownInside, *state.contourer, taskBlocks[t]);
+      return;
+    }
+    KeptTask& kept = keptTasks[t];
+    kept.origin = task.origin;
+    kept.size = task.size;
+    kept.knownInside = task.knownInside;
+    kept.fingerprinted = !task.knownInside && ev.fingerprint(kept.fingerprint);
+    const auto found = previousTasks.find(std::make_pair(task.origin, task.size));
+    const KeptTask* previous =
+      found != previousTasks.end() ? &before->tasks[found->second] : nullptr;
+    SurfaceReuse& reuse = taskReuse[t];
+    if (previous &&
+      sameWork(task.knownInside, kept.fingerprinted, kept.fingerprint, previous->knownInside,
+        previous->fingerprinted, previous->fingerprint))
+    {
+      // The same evaluator over the whole node: its descent would take the same path to the
+      // same blocks.
+      kept.blocks = previous->blocks;
+      for (const KeptBlock& b : kept.blocks)
+      {
+        if (b.block)
+        {
+          taskBlocks[t].push_back(std::make_unique<Block>(*b.block));
+        }
+      }
+      reuse.blocksReused = kept.blocks.size();
+      reuse.tasksReused = 1;
+      return;
+    }
+    TaskMemory taskMemory;
+    taskMemory.previous = previous;
+    taskMemory.next = &kept;
+    if (previous)
+    {
+      taskMemory.byKey.reserve(previous->blocks.size());
+      for (std::size_t b = 0; b < previous->blocks.size(); ++b)
+      {
+        taskMemory.byKey.emplace_back(previous->blocks[b].key, b);
+      }
+      std::sort(taskMemory.byKey.begin(), taskMemory.byKey.end());
+    }
+    descend(ev, layout, task.origin, task.size, task.knownInside, *state.contourer, taskBlocks[t],
+      &taskMemory);
+    reuse.blocksContoured = taskMemory.contoured;
+    reuse.blocksReused = taskMemory.reused;
   };
   auto body = [&](const tbb::blocked_range<std::size_t>& range)
   {
@@ -263,6 +356,26 @@ SurfaceMesh contourSurface(
       });
   };
   runOnThreads(options.threads, run);
+  if (memory)
+  {
+    // Kept only once the call has succeeded (a cancelled call keeps the previous state).
+    SurfaceReuse total;
+    total.tasks = tasks.size();
+    for (const SurfaceReuse& r : taskReuse)
+    {
+      total.blocksContoured += r.blocksContoured;
+      total.blocksReused += r.blocksReused;
+      total.tasksReused += r.tasksReused;
+    }
+    SurfaceMemory::State& state = memory->state();
+    state.valid = true;
+    state.lo = layout.lo;
+    state.h = layout.h;
+    state.pin = layout.pin;
+    state.sharp = options.sharpFeatures;
+    state.tasks = std::move(keptTasks);
+    memory->setLastCall(total);
+  }
   progress.report(1.0);
   return mesh;
 }

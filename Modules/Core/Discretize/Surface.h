@@ -30,9 +30,64 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 
 namespace ictk::discretize
 {
+
+/// What contourSurface did with a SurfaceMemory (SurfaceOptions::memory) in its last call.
+struct SurfaceReuse
+{
+  /// Blocks of BlockCells^3 grid cells (8^3) contoured from the field, and taken from the
+  /// previous call instead; together, every block the octree visited (blocks with no surface
+  /// included).
+  std::size_t blocksContoured = 0;
+  std::size_t blocksReused = 0;
+  /// Octree nodes of 32^3 cells (the threads' tasks) whose whole subtree was taken from the
+  /// previous call without descending into it; their blocks count as reused.
+  std::size_t tasksReused = 0;
+  std::size_t tasks = 0;
+};
+
+/// Work kept between calls of contourSurface on a field that changes in some regions only (a
+/// cell whose shape parameters change from frame to frame: time-coherent re-meshing, thesis
+/// 4.6.8). Each call contours the regions whose field may have changed and takes the others
+/// from the previous call.
+///
+/// Why it is exact: the octree hands every node (a task of 32^3 cells, and each block of 8^3
+/// cells) an evaluator narrowed to the node's box, and what the node yields (its blocks: signs,
+/// Hermite data, vertices) is a function of that evaluator's results, the node's place in the
+/// grid and whether it is known to be inside. The memory keeps, per node, the evaluator's
+/// fingerprint (FieldEvaluator::fingerprint: its pruned tape, the parameter values and time that
+/// tape reads, placements...) and what the node yielded; a node whose evaluator has the same
+/// fingerprint as in the previous call yields the same again, bit for bit, so it is copied
+/// instead. A changed parameter therefore costs only the nodes where the pruned tape still
+/// reads it (where its term can reach the surface); the rest of the assembly (vertex numbering,
+/// quads, repairs) runs every call. A node whose evaluator cannot give a fingerprint is always
+/// contoured, and a different grid (box, feature size, sharp features) forgets everything.
+/// The result is the same mesh as without a memory, for any thread count.
+///
+/// One memory serves one surface (one cell); it is not thread safe: one call at a time.
+class SurfaceMemory
+{
+public:
+  SurfaceMemory();
+  ~SurfaceMemory();
+  SurfaceMemory(const SurfaceMemory&) = delete;
+  SurfaceMemory& operator=(const SurfaceMemory&) = delete;
+  /// The counts of the last call made with this memory.
+  const SurfaceReuse& lastCall() const { return last_; }
+  /// Forgets what was kept.
+  void clear();
+
+  struct State; // SurfaceDetail.h
+  State& state() { return *state_; }
+  void setLastCall(const SurfaceReuse& r) { last_ = r; }
+
+private:
+  std::unique_ptr<State> state_;
+  SurfaceReuse last_;
+};
 
 struct SurfaceOptions
 {
@@ -50,6 +105,9 @@ struct SurfaceOptions
   /// Largest accepted number of grid cells (the dense count over the box, although only cells
   /// near the surface are visited): a guard against absurd resolutions.
   std::size_t maxCells = std::size_t(1) << 36;
+  /// When set: the work of the previous call made with this memory is reused where the field
+  /// did not change, and this call's is kept for the next (SurfaceMemory). The mesh is the same.
+  SurfaceMemory* memory = nullptr;
 };
 
 /// The surface f = 0 of `field` inside `box`. Throws std::invalid_argument for a box that is not

@@ -302,6 +302,61 @@ private:
   std::vector<int> where_;
 };
 
+// --- time coherence (SurfaceMemory, Surface.h) ----------------------------------------------
+
+/// A block as the octree yielded it, before the assembly's repairs and numbering, with what it
+/// was computed from: the fingerprint of the block's evaluator (none when it is known to be
+/// inside: such a block never evaluates the field, its values are +1 inside the box and -1
+/// beyond).
+struct KeptBlock
+{
+  std::uint64_t key = 0;
+  bool knownInside = false;
+  bool fingerprinted = false;
+  std::vector<std::uint64_t> fingerprint;
+  std::shared_ptr<const Block> block; ///< null: the block has no active cell
+};
+
+/// A task (an octree node handed to a thread) and its blocks, in descent order.
+struct KeptTask
+{
+  std::array<int, 3> origin{};
+  int size = 0;
+  bool knownInside = false;
+  bool fingerprinted = false;
+  std::vector<std::uint64_t> fingerprint;
+  std::vector<KeptBlock> blocks;
+};
+
+/// What one task of a call with a SurfaceMemory reuses (the previous call's task at the same
+/// place) and keeps (this call's).
+struct TaskMemory
+{
+  const KeptTask* previous = nullptr;
+  std::vector<std::pair<std::uint64_t, std::size_t>> byKey; // previous->blocks, sorted by key
+  KeptTask* next = nullptr;
+  std::size_t contoured = 0;
+  std::size_t reused = 0;
+  const KeptBlock* find(std::uint64_t key) const
+  {
+    const auto it =
+      std::lower_bound(byKey.begin(), byKey.end(), std::make_pair(key, std::size_t(0)));
+    return it != byKey.end() && it->first == key ? &previous->blocks[it->second] : nullptr;
+  }
+};
+
+/// Whether kept work done with (knownInside, fingerprint) holds for a node now: known inside
+/// both times (the field is not evaluated), or evaluators with equal fingerprints.
+inline bool sameWork(bool knownInside, bool fingerprinted, const std::vector<std::uint64_t>& fp,
+  bool keptInside, bool keptFingerprinted, const std::vector<std::uint64_t>& keptFp)
+{
+  if (knownInside != keptInside)
+  {
+    return false;
+  }
+  return knownInside || (fingerprinted && keptFingerprinted && fp == keptFp);
+}
+
 // --- octree (SurfaceOctree.cxx) --------------------------------------------------------------
 
 /// A node of the octree handed to a thread.
@@ -318,9 +373,11 @@ void collectTasks(FieldEvaluator& ev, const Layout& layout, const std::array<int
   std::vector<Task>& tasks);
 
 /// Descends the node at `o` to its blocks that may hold the surface and contours them into
-/// `blocks`, in octree order.
+/// `blocks`, in octree order. With `memory`: a block whose evaluator has the fingerprint it had
+/// in the previous call is copied from it instead, and every block visited is kept.
 void descend(FieldEvaluator& ev, const Layout& layout, const std::array<int, 3>& o, int size,
-  bool knownInside, BlockContourer& contourer, std::vector<std::unique_ptr<Block>>& blocks);
+  bool knownInside, BlockContourer& contourer, std::vector<std::unique_ptr<Block>>& blocks,
+  TaskMemory* memory = nullptr);
 
 // --- non-manifold repair (SurfaceRepair.cxx) -------------------------------------------------
 
@@ -331,3 +388,20 @@ void splitVertices(std::vector<std::unique_ptr<Block>>& blocks, const BlockIndex
   const Layout& layout, bool sharp);
 
 } // namespace ictk::discretize::detail::surface
+
+namespace ictk::discretize
+{
+
+struct SurfaceMemory::State
+{
+  /// The grid the kept work belongs to: another grid forgets it.
+  bool valid = false;
+  Point3 lo{};
+  double h = 0;
+  std::array<int, 3> pin{};
+  bool sharp = true;
+  /// In the order of collectTasks.
+  std::vector<detail::surface::KeptTask> tasks;
+};
+
+} // namespace ictk::discretize

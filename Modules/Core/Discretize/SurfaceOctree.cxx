@@ -106,7 +106,8 @@ Layout makeLayout(const Box3& box, const SurfaceOptions& options)
 }
 
 void descend(FieldEvaluator& ev, const Layout& layout, const std::array<int, 3>& o, int size,
-  bool knownInside, BlockContourer& contourer, std::vector<std::unique_ptr<Block>>& blocks)
+  bool knownInside, BlockContourer& contourer, std::vector<std::unique_ptr<Block>>& blocks,
+  TaskMemory* memory)
 {
   if (size == BlockCells)
   {
@@ -114,11 +115,42 @@ void descend(FieldEvaluator& ev, const Layout& layout, const std::array<int, 3>&
     {
       return;
     }
-    auto block = std::make_unique<Block>();
-    if (contourer.run(ev, o, knownInside, *block))
+    if (!memory)
     {
-      blocks.push_back(std::move(block));
+      auto block = std::make_unique<Block>();
+      if (contourer.run(ev, o, knownInside, *block))
+      {
+        blocks.push_back(std::move(block));
+      }
+      return;
     }
+    KeptBlock kept;
+    kept.key = layout.blockKey(o);
+    kept.knownInside = knownInside;
+    kept.fingerprinted = !knownInside && ev.fingerprint(kept.fingerprint);
+    const KeptBlock* before = memory->find(kept.key);
+    if (before &&
+      sameWork(knownInside, kept.fingerprinted, kept.fingerprint, before->knownInside,
+        before->fingerprinted, before->fingerprint))
+    {
+      kept.block = before->block;
+      if (kept.block)
+      {
+        blocks.push_back(std::make_unique<Block>(*kept.block));
+      }
+      ++memory->reused;
+    }
+    else
+    {
+      auto block = std::make_unique<Block>();
+      if (contourer.run(ev, o, knownInside, *block))
+      {
+        kept.block = std::make_shared<const Block>(*block);
+        blocks.push_back(std::move(block));
+      }
+      ++memory->contoured;
+    }
+    memory->next->blocks.push_back(std::move(kept));
     return;
   }
   const int half = size / 2;
@@ -134,7 +166,7 @@ void descend(FieldEvaluator& ev, const Layout& layout, const std::array<int, 3>&
     {
       if (layout.touchesOutside(child, half))
       {
-        descend(ev, layout, child, half, true, contourer, blocks);
+        descend(ev, layout, child, half, true, contourer, blocks, memory);
       }
       continue;
     }
@@ -145,11 +177,11 @@ void descend(FieldEvaluator& ev, const Layout& layout, const std::array<int, 3>&
     }
     if (kind == NodeKind::Inside)
     {
-      descend(ev, layout, child, half, true, contourer, blocks);
+      descend(ev, layout, child, half, true, contourer, blocks, memory);
       continue;
     }
     std::unique_ptr<FieldEvaluator> narrowed = ev.narrowed(layout.clippedBox(child, half));
-    descend(narrowed ? *narrowed : ev, layout, child, half, false, contourer, blocks);
+    descend(narrowed ? *narrowed : ev, layout, child, half, false, contourer, blocks, memory);
   }
 }
 

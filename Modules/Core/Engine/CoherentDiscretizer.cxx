@@ -9,8 +9,10 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <utility>
+#include <variant>
 
 namespace ictk::engine
 {
@@ -113,6 +115,8 @@ CoherenceStats& CoherenceStats::operator+=(const CoherenceStats& o)
   computed += o.computed;
   moved += o.moved;
   reused += o.reused;
+  blocksContoured += o.blocksContoured;
+  blocksReused += o.blocksReused;
   seconds += o.seconds;
   return *this;
 }
@@ -231,7 +235,43 @@ complex::ComplexMesh CoherentDiscretizer::discretize(const std::vector<CellState
       cellOptions.progress = nullptr;
       Kept kept;
       kept.version = state.shapeVersion;
+      const complex::Cell& made = one.cell(localId);
+      if (options_.coherent && found != kept_.end() && made.dimension == 3 &&
+        std::holds_alternative<complex::ImplicitGeometry>(made.geometry))
+      {
+        const Kept& before = found->second;
+        kept.surface =
+          before.surface ? before.surface : std::make_shared<discretize::SurfaceMemory>();
+        kept.misses = before.misses;
+        kept.skip = before.skip;
+        if (kept.skip > 0)
+        {
+          --kept.skip;
+        }
+        else
+        {
+          kept.surface->setLastCall({});
+          cellOptions.surfaceMemory = kept.surface.get();
+        }
+      }
       kept.local = complex::discretizeCell(one, localId, cellOptions);
+      if (cellOptions.surfaceMemory)
+      {
+        const discretize::SurfaceReuse& r = kept.surface->lastCall();
+        frame.blocksContoured += r.blocksContoured;
+        frame.blocksReused += r.blocksReused;
+        // A memory's first call has nothing to reuse: only later calls count as misses.
+        const bool tried = found->second.surface != nullptr;
+        if (tried && r.blocksReused == 0 && r.blocksContoured > 0)
+        {
+          kept.misses = std::min<std::uint32_t>(kept.misses + 1, 6);
+          kept.skip = (1u << kept.misses) - 1;
+        }
+        else if (r.blocksReused > 0)
+        {
+          kept.misses = 0;
+        }
+      }
       // Attributes are evaluated where the points are, every frame; the point arrays that come
       // with an explicit geometry (a skinned mesh's dominant joint) go with the points.
       const auto* given = std::get_if<complex::ExplicitGeometry>(&one.cell(localId).geometry);

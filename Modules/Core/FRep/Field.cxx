@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace ictk::frep
@@ -63,6 +64,12 @@ public:
       return nullptr;
     }
     return std::make_unique<TapeFieldEvaluator>(std::move(pruned), time_, parameters_);
+  }
+
+  bool fingerprint(std::vector<std::uint64_t>& out) const override
+  {
+    appendTapeFingerprint(*tape_, time_, parameters_, out);
+    return true;
   }
 
 private:
@@ -254,6 +261,43 @@ public:
     return e;
   }
 
+  bool fingerprint(std::vector<std::uint64_t>& out) const override
+  {
+    out.push_back(0x636f6d62696e6564ull); // "combined"
+    out.push_back(static_cast<std::uint64_t>(op_));
+    out.push_back(parts_.size());
+    // Each part's words are preceded by their count, so that no two lists of parts give the
+    // same words.
+    auto nested = [&out](const FieldEvaluator& e)
+    {
+      const std::size_t at = out.size();
+      out.push_back(0);
+      if (!e.fingerprint(out))
+      {
+        return false;
+      }
+      out[at] = out.size() - at - 1;
+      return true;
+    };
+    for (const auto& p : parts_)
+    {
+      if (!nested(*p))
+      {
+        return false;
+      }
+    }
+    // narrowed() falls back on the source fields' own evaluators: they are part of what it does.
+    out.push_back(sources_.size());
+    for (const auto& f : sources_)
+    {
+      if (!nested(*f->evaluator()))
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+
   // The fields the parts came from: a part that does not narrow is re-created from its field,
   // so that a narrowed evaluator never shares state with its parent.
   void setSources(std::vector<FieldPtr> sources) { sources_ = std::move(sources); }
@@ -329,6 +373,71 @@ private:
 };
 
 } // namespace
+
+std::uint64_t fingerprintWord(double v)
+{
+  std::uint64_t w = 0;
+  std::memcpy(&w, &v, sizeof w);
+  return w;
+}
+
+void appendTapeFingerprint(const Tape& tape, double time, const std::vector<double>& parameters,
+  std::vector<std::uint64_t>& out)
+{
+  const auto& code = tape.instructions();
+  out.push_back(0x7461706500000000ull); // "tape"
+  out.push_back(tape.parameterCount());
+  out.push_back(tape.constants().size());
+  out.push_back(code.size());
+  out.push_back(tape.outputs().size());
+  out.push_back(tape.slotCount());
+  // The slots the tape reads: the parameters and t it does not read cannot change its results.
+  std::vector<bool> read(tape.temporaryBase(), false);
+  auto reads = [&](std::uint32_t slot)
+  {
+    if (slot < read.size())
+    {
+      read[slot] = true;
+    }
+  };
+  for (const Instruction& ins : code)
+  {
+    out.push_back((static_cast<std::uint64_t>(ins.op) << 32) | ins.out);
+    out.push_back((static_cast<std::uint64_t>(ins.a) << 32) | ins.b);
+    out.push_back(ins.c);
+    const int arity = opcodeArity(ins.op);
+    if (arity >= 1)
+    {
+      reads(ins.a);
+    }
+    if (arity >= 2)
+    {
+      reads(ins.b);
+    }
+    if (arity >= 3)
+    {
+      reads(ins.c);
+    }
+  }
+  for (std::uint32_t o : tape.outputs())
+  {
+    out.push_back(o);
+    reads(o);
+  }
+  for (double c : tape.constants())
+  {
+    out.push_back(fingerprintWord(c));
+  }
+  // Which slots are read follows from the instructions above; an unread one gets a fixed word.
+  constexpr std::uint64_t Unread = 0x756e72656164ull; // "unread"
+  for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
+  {
+    out.push_back(read[tape.parameterBase() + i] && i < parameters.size()
+        ? fingerprintWord(parameters[i])
+        : Unread);
+  }
+  out.push_back(read[static_cast<std::size_t>(Axis::T)] ? fingerprintWord(time) : Unread);
+}
 
 FieldPtr tapeField(TapePtr tape, double time, std::vector<double> parameters)
 {

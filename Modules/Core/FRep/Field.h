@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -57,7 +58,28 @@ public:
     (void)box;
     return nullptr;
   }
+  /// Appends to `out` words that determine what this evaluator computes: two evaluators whose
+  /// fingerprints are equal give bit-identical values, bounds, gradients and narrowed evaluators
+  /// for identical calls (a tape's instructions, constants and the parameter values and time it
+  /// reads, an operation and its operands' fingerprints, a placement's coefficients). Time
+  /// coherence relies on it to reuse the work done on a region whose field did not change
+  /// (discretize::SurfaceMemory), so it must describe everything the results depend on; words
+  /// that do not matter only cost reuse. Returns false, leaving `out` in an unspecified state,
+  /// when the evaluator cannot describe itself (the default): then nothing may be reused.
+  virtual bool fingerprint(std::vector<std::uint64_t>& out) const
+  {
+    (void)out;
+    return false;
+  }
 };
+
+/// Fingerprint words (FieldEvaluator::fingerprint): a double by its bits, so that equal words mean
+/// equal values (and -0 differs from 0, NaNs by payload: only reuse is lost).
+std::uint64_t fingerprintWord(double v);
+/// Appends `tape`'s fingerprint: its instructions, outputs, constants, and the values of the
+/// parameters and of t it reads (a parameter no instruction reads does not change the results).
+void appendTapeFingerprint(const Tape& tape, double time, const std::vector<double>& parameters,
+  std::vector<std::uint64_t>& out);
 
 class Field;
 using FieldPtr = std::shared_ptr<const Field>;

@@ -261,29 +261,47 @@ class ShapeFieldEvaluator final : public frep::FieldEvaluator
 public:
   explicit ShapeFieldEvaluator(std::shared_ptr<const PlacedShape> shape)
     : shape_(std::move(shape))
-    , prepared_(*shape_)
+    , prepared_(std::make_unique<Prepared>(*shape_))
+  {
+  }
+  ShapeFieldEvaluator(std::shared_ptr<const PlacedShape> shape, std::unique_ptr<Prepared> prepared)
+    : shape_(std::move(shape))
+    , prepared_(std::move(prepared))
   {
   }
   void values(
     const double* x, const double* y, const double* z, double* out, std::size_t n) override
   {
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      out[i] = prepared_.value({ x[i], y[i], z[i] });
-    }
+    prepared_->values(x, y, z, out, n);
   }
-  Interval bound(const Box3& box) override { return prepared_.bound(box); }
+  Interval bound(const Box3& box) override { return prepared_->bound(box); }
   double gradient(const frep::Point3& p, frep::Point3& grad) override
   {
     Vec3 g;
-    const double v = prepared_.gradient(p, g);
+    const double v = prepared_->gradient(p, g);
     grad = g;
     return v;
+  }
+  /// The fields of the parts narrowed to the box (their tapes pruned there): cheaper, and
+  /// what a region's fingerprint depends on is only what can matter there.
+  std::unique_ptr<frep::FieldEvaluator> narrowed(const Box3& box) override
+  {
+    bool changed = false;
+    auto p = std::make_unique<Prepared>(*prepared_, box, changed);
+    if (!changed)
+    {
+      return nullptr;
+    }
+    return std::make_unique<ShapeFieldEvaluator>(shape_, std::move(p));
+  }
+  bool fingerprint(std::vector<std::uint64_t>& out) const override
+  {
+    return prepared_->fingerprint(out);
   }
 
 private:
   std::shared_ptr<const PlacedShape> shape_;
-  Prepared prepared_;
+  std::unique_ptr<Prepared> prepared_;
 };
 
 class ShapeField final : public frep::Field

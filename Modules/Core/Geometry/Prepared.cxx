@@ -239,6 +239,141 @@ Prepared::Prepared(const PlacedShape& s)
   scale = std::max(boxDiagonal(bounds), 1e-300);
 }
 
+Prepared::Prepared(const Prepared& parent, const Box3& w, bool& changed)
+  : shape(parent.shape)
+  , dim(parent.dim)
+  , flat(parent.flat)
+  , analytic(parent.analytic)
+  , pieces(parent.pieces)
+  , bounds(parent.bounds)
+  , scale(parent.scale)
+{
+  const Box3 world = flatten(w, flat);
+  for (const PreparedPart& from : parent.parts)
+  {
+    PreparedPart pp;
+    pp.part = from.part;
+    pp.dim = from.dim;
+    pp.toLocal = from.toLocal;
+    pp.eval = from.eval;
+    pp.domain = from.domain;
+    pp.hx = from.hx;
+    pp.hy = from.hy;
+    pp.hd = from.hd;
+    const ShapePart::Kind kind = from.part->kind;
+    if (kind == ShapePart::Kind::Field && pp.dim >= 2)
+    {
+      // The local points of w lie in mapBox(toLocal, w) up to the rounding of the map, which the
+      // margin covers: the narrowed field is only ever evaluated inside the box it was narrowed
+      // to.
+      Box3 l = mapBox(pp.toLocal, world);
+      if (pp.dim <= 2)
+      {
+        l.lo[2] = l.hi[2] = 0;
+      }
+      for (int i = 0; i < 3; ++i)
+      {
+        const double margin =
+          1e-9 * (std::abs(l.lo[i]) + std::abs(l.hi[i]) + (l.hi[i] - l.lo[i])) + 1e-300;
+        l.lo[i] -= margin;
+        l.hi[i] += margin;
+      }
+      if (auto n = from.eval->narrowed(l))
+      {
+        pp.eval = std::move(n);
+        changed = true;
+      }
+    }
+    else if ((kind == ShapePart::Kind::Blend || kind == ShapePart::Kind::Union) && from.a && from.b)
+    {
+      pp.a = std::make_unique<Prepared>(*from.a, w, changed);
+      pp.b = std::make_unique<Prepared>(*from.b, w, changed);
+    }
+    else if (from.a && from.b)
+    {
+      // A space-time blend evaluates its operands at warped points: left as they are.
+      pp.a = std::make_unique<Prepared>(*from.a->shape);
+      pp.b = std::make_unique<Prepared>(*from.b->shape);
+    }
+    parts.push_back(std::move(pp));
+  }
+}
+
+bool Prepared::fingerprint(std::vector<std::uint64_t>& out) const
+{
+  using frep::fingerprintWord;
+  // A nested list of words is preceded by its count, so that no two shapes give the same words.
+  auto nested = [&out](const auto& append)
+  {
+    const std::size_t at = out.size();
+    out.push_back(0);
+    if (!append())
+    {
+      return false;
+    }
+    out[at] = out.size() - at - 1;
+    return true;
+  };
+  out.push_back(0x7072657061726564ull); // "prepared"
+  out.push_back(static_cast<std::uint64_t>(dim));
+  out.push_back(flat ? 1 : 0);
+  out.push_back(parts.size());
+  for (const PreparedPart& pp : parts)
+  {
+    const ShapePart& p = *pp.part;
+    out.push_back(static_cast<std::uint64_t>(p.kind));
+    out.push_back(static_cast<std::uint64_t>(pp.dim));
+    if (pp.dim < 2)
+    {
+      continue; // points and curves are not part of the field (value() skips them)
+    }
+    for (double v : pp.toLocal.a)
+    {
+      out.push_back(fingerprintWord(v));
+    }
+    for (double v : pp.toLocal.b)
+    {
+      out.push_back(fingerprintWord(v));
+    }
+    switch (p.kind)
+    {
+      case ShapePart::Kind::Rectangle:
+      case ShapePart::Kind::Disk:
+      case ShapePart::Kind::CircularSegment:
+      case ShapePart::Kind::Box:
+      case ShapePart::Kind::Sphere:
+        for (double v : { p.size[0], p.size[1], p.size[2], p.radius, pp.hx, pp.hy, pp.hd })
+        {
+          out.push_back(fingerprintWord(v));
+        }
+        break;
+      case ShapePart::Kind::Field:
+        for (int i = 0; i < 3; ++i)
+        {
+          out.push_back(fingerprintWord(pp.domain.lo[i]));
+          out.push_back(fingerprintWord(pp.domain.hi[i]));
+        }
+        if (!nested([&] { return pp.eval->fingerprint(out); }))
+        {
+          return false;
+        }
+        break;
+      case ShapePart::Kind::Blend:
+      case ShapePart::Kind::Union:
+        out.push_back(fingerprintWord(p.amount));
+        if (!nested([&] { return pp.a->fingerprint(out); }) ||
+          !nested([&] { return pp.b->fingerprint(out); }))
+        {
+          return false;
+        }
+        break;
+      default:
+        return false;
+    }
+  }
+  return true;
+}
+
 V2 Prepared::world2(double x, double y) const
 {
   return xy(shape->place.apply({ x, y, 0 }));
@@ -385,6 +520,80 @@ double Prepared::value(Vec3 w) const
     }
   }
   return v;
+}
+
+void Prepared::values(
+  const double* x, const double* y, const double* z, double* out, std::size_t n) const
+{
+  std::fill(out, out + n, -Inf);
+  std::vector<double> zeros;
+  if (flat)
+  {
+    zeros.assign(n, 0.0);
+    z = zeros.data();
+  }
+  std::vector<double> part(n);
+  for (const auto& pp : parts)
+  {
+    if (pp.dim >= 2)
+    {
+      partValues(pp, x, y, z, part.data(), n);
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        out[i] = std::max(out[i], part[i]);
+      }
+    }
+  }
+}
+
+void Prepared::partValues(const PreparedPart& pp, const double* x, const double* y, const double* z,
+  double* out, std::size_t n) const
+{
+  const ShapePart& p = *pp.part;
+  if (p.kind == ShapePart::Kind::Blend || p.kind == ShapePart::Kind::Union)
+  {
+    std::vector<double> fb(n);
+    pp.a->values(x, y, z, out, n);
+    pp.b->values(x, y, z, fb.data(), n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      out[i] = p.kind == ShapePart::Kind::Union ? std::max(out[i], fb[i])
+                                                : blendUnion(out[i], fb[i], p.amount);
+    }
+    return;
+  }
+  if (p.kind != ShapePart::Kind::Field)
+  {
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      out[i] = partValue(pp, { x[i], y[i], z[i] });
+    }
+    return;
+  }
+  // The local points, then the field at all of them in one call.
+  std::vector<double> local(3 * n);
+  double* lx = local.data();
+  double* ly = lx + n;
+  double* lz = ly + n;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Vec3 l = pp.toLocal.apply({ x[i], y[i], z[i] });
+    lx[i] = l[0];
+    ly[i] = l[1];
+    lz[i] = pp.dim <= 2 ? 0.0 : l[2];
+  }
+  pp.eval->values(lx, ly, lz, out, n);
+  const int axes = pp.dim == 2 ? 2 : 3;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    double f = std::isnan(out[i]) ? -Inf : out[i];
+    const double l[3] = { lx[i], ly[i], lz[i] };
+    for (int a = 0; a < axes; ++a)
+    {
+      f = std::min({ f, l[a] - pp.domain.lo[a], pp.domain.hi[a] - l[a] });
+    }
+    out[i] = f;
+  }
 }
 
 Interval Prepared::partBound(const PreparedPart& pp, const Box3& w) const

@@ -13,6 +13,7 @@
 #include "FRep/Interval.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -115,7 +116,9 @@ struct PreparedPart
   const ShapePart* part = nullptr;
   int dim = 0;
   Affine toLocal;
-  std::unique_ptr<frep::FieldEvaluator> eval;
+  /// Shared by a shape narrowed to a box (Prepared's narrowing constructor) where a field does
+  /// not narrow further: both are used by one thread, one call at a time.
+  std::shared_ptr<frep::FieldEvaluator> eval;
   Box3 domain;
   std::unique_ptr<Prepared> a, b;
   double hx = 0, hy = 0, hd = 0; // CircularSegment: the chord's half-plane hx x + hy y >= hd
@@ -133,12 +136,27 @@ struct Prepared
   double scale = 1; ///< the bounds' diagonal, for relative steps
 
   explicit Prepared(const PlacedShape& s);
+  /// `parent` with the fields of its Field parts, and of its blends' and unions' operands,
+  /// narrowed to the world box `w` (FieldEvaluator::narrowed): the same values, enclosures and
+  /// gradients inside w, cheaper, and independent of what changes only outside w (a parameter
+  /// of a term pruned away there). `changed` is set when some field narrowed.
+  Prepared(const Prepared& parent, const Box3& w, bool& changed);
+  /// Appends the words that determine its world field (FieldEvaluator::fingerprint): the parts'
+  /// kinds, placements, sizes and domains, their fields' fingerprints, the blends' amounts and
+  /// operands. false for a part it cannot describe (a space-time blend).
+  bool fingerprint(std::vector<std::uint64_t>& out) const;
 
   V2 world2(double x, double y) const;
   void addPieces(const ShapePart& part);
   double partValue(const PreparedPart& pp, Vec3 w) const;
   /// The world field (>= 0 inside; the max over the 2D/3D parts).
   double value(Vec3 w) const;
+  /// value() at n points given as coordinate arrays, a Field part's field evaluated in one
+  /// FieldEvaluator::values call (batched, several times cheaper than point by point; the values
+  /// may differ from value()'s in the last bits, as the batch and gradient evaluators do).
+  void values(const double* x, const double* y, const double* z, double* out, std::size_t n) const;
+  void partValues(const PreparedPart& pp, const double* x, const double* y, const double* z,
+    double* out, std::size_t n) const;
   Interval partBound(const PreparedPart& pp, const Box3& w) const;
   /// An enclosure of value() over a world box.
   Interval bound(Box3 w) const;
