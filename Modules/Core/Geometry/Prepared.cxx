@@ -557,8 +557,8 @@ void Prepared::partValues(const PreparedPart& pp, const double* x, const double*
     pp.b->values(x, y, z, fb.data(), n);
     for (std::size_t i = 0; i < n; ++i)
     {
-      out[i] = p.kind == ShapePart::Kind::Union ? std::max(out[i], fb[i])
-                                                : blendUnion(out[i], fb[i], p.amount);
+      out[i] =
+        p.kind == ShapePart::Kind::Union ? std::max(out[i], fb[i]) : blendUnion(out[i], fb[i], p);
     }
     return;
   }
