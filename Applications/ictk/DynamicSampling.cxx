@@ -152,15 +152,6 @@ frep::Grid PlanDynamicGrid(
   if (!o.Dims.empty())
   {
     dims = ParseDims(o.Dims);
-    static const char* names[] = { "NX", "NY", "NZ" };
-    for (int a = 0; a < 3; ++a)
-    {
-      if (dims[a] < 1)
-      {
-        throw UserError(std::string("--dims: ") + names[a] + " must be at least 1, got " +
-          std::to_string(dims[a]));
-      }
-    }
   }
   else if (o.Resolution < 2)
   {

@@ -186,6 +186,15 @@ std::array<std::int64_t, 3> ParseDims(const std::string& text)
 {
   const std::vector<std::int64_t> v =
     ParseIntegers(text, "--dims", { "NX", "NY", "NZ" }, "NX,NY,NZ");
+  static const char* names[] = { "NX", "NY", "NZ" };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (v[a] < 1)
+    {
+      throw UserError(
+        std::string("--dims: ") + names[a] + " must be at least 1, got " + std::to_string(v[a]));
+    }
+  }
   return { v[0], v[1], v[2] };
 }
 

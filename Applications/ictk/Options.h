@@ -65,7 +65,7 @@ std::vector<std::int64_t> ParseIntegers(const std::string& text, const std::stri
   const std::vector<std::string>& names, const std::string& expected);
 /// --bounds: x0,x1,y0,y1,z0,z1 into lo and hi (a UserError for x0 > x1 and the like).
 void ParseBounds(const std::string& text, std::array<double, 3>& lo, std::array<double, 3>& hi);
-/// --dims: NX,NY,NZ, integers (their range is checked by the caller).
+/// --dims: NX,NY,NZ, integers of at least 1 (their upper bounds are the caller's).
 std::array<std::int64_t, 3> ParseDims(const std::string& text);
 
 /// The frame times of "T0:T1:DT": T0, T0 + DT, ... while <= T1 (with DT / 1000 of slack for
