@@ -160,6 +160,7 @@ StudySettings readSettings(const std::string& path)
   }
   out.scan = stringAt(s, "scan", where);
   std::vector<std::string> cellNames;
+  bool scanIsVoxelCell = false;
   if (doc.contains("cells") && doc["cells"].is_array())
   {
     for (const Json& cell : doc["cells"])
@@ -167,18 +168,16 @@ StudySettings readSettings(const std::string& path)
       if (cell.is_object() && cell.contains("name") && cell["name"].is_string())
       {
         cellNames.push_back(cell["name"].get<std::string>());
-        if (cellNames.back() == out.scan && cell.value("kind", Json()) != "V")
-        {
-          cellNames.back().clear(); // not a voxel cell: cannot be the scan
-        }
+        scanIsVoxelCell =
+          scanIsVoxelCell || (cellNames.back() == out.scan && cell.value("kind", Json()) == "V");
       }
     }
   }
   const auto isCell = [&](const std::string& name)
   {
-    return !name.empty() && std::find(cellNames.begin(), cellNames.end(), name) != cellNames.end();
+    return std::find(cellNames.begin(), cellNames.end(), name) != cellNames.end();
   };
-  if (!isCell(out.scan))
+  if (!scanIsVoxelCell)
   {
     throw UserError(where + ": \"scan\" must name a voxel (V) cell of the complex");
   }
@@ -186,7 +185,7 @@ StudySettings readSettings(const std::string& path)
   {
     for (const std::string& name : names)
     {
-      if (!isCell(name) && name != out.scan)
+      if (!isCell(name))
       {
         throw UserError(
           where + ": \"" + key + "\" names '" + name + "', which is not a cell of the complex");
@@ -249,7 +248,7 @@ StudySettings readSettings(const std::string& path)
   for (const auto& [name, f] : fixed.items())
   {
     const std::string at = where + ".fixed." + name;
-    if (!isCell(name) && name != out.scan)
+    if (!isCell(name))
     {
       throw UserError(at + ": '" + name + "' is not a cell of the complex");
     }
