@@ -16,6 +16,7 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -322,6 +323,19 @@ void saveSceneFile(const std::string& input, const std::string& path, const Limi
   writeAtomically(path, writeScene(readSceneFile(input, limits)));
 }
 
+void saveBlobFile(const BlobModelFile& blob, const std::string& path, std::optional<double> time)
+{
+  if (formatOf(path) != Format::Blob)
+  {
+    throw std::invalid_argument("cannot save '" + path + "' as a BlobTree: it is not a .blob file");
+  }
+  if (time && !std::isfinite(*time))
+  {
+    throw std::invalid_argument("cannot save '" + path + "': the time is not a finite number");
+  }
+  writeAtomically(path, writeBlob(time ? blob.tree.instantiate(*time) : blob.tree));
+}
+
 void saveModelFile(const ModelFile& model, const std::string& path)
 {
   std::string text;
@@ -340,9 +354,11 @@ void saveModelFile(const ModelFile& model, const std::string& path)
       throw std::invalid_argument("cannot save '" + path +
         "': a scene is written only from a scene (saveSceneFile; `ictk convert in.scn out.scn`)");
     case Format::Blob:
+      // A hypervolume is an expression: the skeletal elements and operators of a BlobTree
+      // cannot be recovered from it.
       throw std::invalid_argument("cannot save '" + path +
-        "': .blob files are read only (a BlobTree is written by hand or generated; see "
-        "docs/blobtree.md)");
+        "': a .blob is written only from a BlobTree (saveBlobFile; `ictk convert in.blob "
+        "out.blob`), not from a hypervolume");
     default:
       unknownExtension(path);
   }

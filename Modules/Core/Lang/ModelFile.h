@@ -67,5 +67,12 @@ void saveModelFile(const ModelFile& model, const std::string& path);
 /// Writes the scene file `input` as one self-contained scene file `path` (its `object`
 /// references inlined, seed 003 line 157), atomically as saveModelFile.
 void saveSceneFile(const std::string& input, const std::string& path, const Limits& limits = {});
+/// Writes a BlobTree as the .blob file `path` (lang::writeBlob), atomically as saveModelFile: the
+/// tree as read, its animations kept, or with `time` its static instance at that time (generalised
+/// cylinders and surfaces of revolution expanded into their elements, every animated value at
+/// its value at t). Throws std::invalid_argument for a path that is not a .blob or a time that is
+/// not finite, std::runtime_error when the file cannot be written.
+void saveBlobFile(
+  const BlobModelFile& blob, const std::string& path, std::optional<double> time = std::nullopt);
 
 } // namespace ictk::lang
