@@ -244,39 +244,28 @@ render::Canvas DrawMeshes(const render::ScenePrimitives& scene, const render::Ca
   vtkDataArray* pixels = rgba->GetOutput()->GetPointData()->GetScalars();
   vtkDataArray* depths = z->GetOutput()->GetPointData()->GetScalars();
 
+  // VTK's z-buffer holds OpenGL window depths for the clipping range: back to distances along
+  // the rays (render::depthFromWindow, the inverse of the convention windowDepth writes).
   render::Canvas canvas(camera.width(), camera.height());
-  const double n = clip[0], f = clip[1];
-  for (int j = 0; j < camera.height(); ++j)
+  std::vector<double> windowDepths(canvas.depth.size());
+  for (std::size_t p = 0; p < windowDepths.size(); ++p)
   {
-    for (int i = 0; i < camera.width(); ++i)
+    windowDepths[p] = depths->GetComponent(static_cast<vtkIdType>(p), 0);
+  }
+  canvas.depth = render::depthFromWindow(windowDepths, camera, clip[0], clip[1]);
+  for (std::size_t p = 0; p < windowDepths.size(); ++p)
+  {
+    if (!std::isfinite(canvas.depth[p]))
     {
-      const std::size_t p = canvas.index(i, j);
-      const double zb = depths->GetComponent(static_cast<vtkIdType>(p), 0);
-      if (!(zb < 1))
-      {
-        continue; // the far plane: background
-      }
-      // The depth along the viewing axis from the z-buffer, then the distance along the ray.
-      double s = 0;
-      if (perspective)
-      {
-        const double ndc = 2 * zb - 1;
-        s = 2 * n * f / ((f + n) - ndc * (f - n));
-      }
-      else
-      {
-        s = n + zb * (f - n);
-      }
-      const auto d = camera.direction(camera.u(i), camera.v(j));
-      canvas.depth[p] = s * std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      canvas.owner[p] = 0;
-      for (int c = 0; c < 4; ++c)
-      {
-        canvas.colour[4 * p + c] =
-          static_cast<std::uint8_t>(pixels->GetComponent(static_cast<vtkIdType>(p), c));
-      }
-      canvas.colour[4 * p + 3] = 255;
+      continue; // the far plane: background
     }
+    canvas.owner[p] = 0;
+    for (int c = 0; c < 4; ++c)
+    {
+      canvas.colour[4 * p + static_cast<std::size_t>(c)] =
+        static_cast<std::uint8_t>(pixels->GetComponent(static_cast<vtkIdType>(p), c));
+    }
+    canvas.colour[4 * p + 3] = 255;
   }
   return canvas;
 }

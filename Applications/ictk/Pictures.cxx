@@ -9,6 +9,7 @@
 #include "FRep/Progress.h"
 
 #include <vtkDoubleArray.h>
+#include <vtkFloatArray.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
@@ -176,6 +177,15 @@ void WriteDepth(const PictureBuffers& picture, AtomicOutput& file)
   depth->SetNumberOfTuples(static_cast<vtkIdType>(picture.Width) * picture.Height);
   std::copy(picture.Depth->begin(), picture.Depth->end(), depth->GetPointer(0));
   image->GetPointData()->SetScalars(depth);
+  if (picture.Normal && !picture.Normal->empty())
+  {
+    vtkNew<vtkFloatArray> normal;
+    normal->SetName("normal");
+    normal->SetNumberOfComponents(3);
+    normal->SetNumberOfTuples(static_cast<vtkIdType>(picture.Width) * picture.Height);
+    std::copy(picture.Normal->begin(), picture.Normal->end(), normal->GetPointer(0));
+    image->GetPointData()->SetNormals(normal);
+  }
   vtkNew<vtkXMLImageDataWriter> xml;
   xml->SetDataModeToAppended();
   xml->EncodeAppendedDataOff();

@@ -23,12 +23,15 @@ struct PictureBuffers
   int Height = 0;
   const std::vector<std::uint8_t>* Colour = nullptr;
   const std::vector<double>* Depth = nullptr;
+  /// Unit normals facing the camera, 3 a pixel; null or empty when the renderer gives none.
+  const std::vector<float>* Normal = nullptr;
 };
 
 /// Writes the colour as PNG into `file` (an AtomicOutput of `path`) and commits it.
 void WritePng(const PictureBuffers& picture, AtomicOutput& file, const std::string& path);
-/// Writes the depth buffer (array `depth`, inf where nothing is hit) as .vti into `file` (through
-/// WriteXml: a full disk fails cleanly) and commits it.
+/// Writes the depth buffer (array `depth`, inf where nothing is hit) and, when there is one, the
+/// normal buffer (array `normal`, 3 components, 0 where nothing is hit) as .vti into `file`
+/// (through WriteXml: a full disk fails cleanly) and commits it.
 void WriteDepth(const PictureBuffers& picture, AtomicOutput& file);
 
 /// The destination of a range of frames: a pattern with one printf integer conversion (%d,

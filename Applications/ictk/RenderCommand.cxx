@@ -57,6 +57,8 @@ struct Drawn
   int Height = 0;
   std::vector<std::uint8_t> Colour;
   std::vector<double> Depth;
+  /// The surfaces' normals, 3 a pixel (empty when the renderer gives none: --mode mesh).
+  std::vector<float> Normal;
   std::int64_t Covered = 0;
   std::int64_t Unresolved = 0;
   std::int64_t Cut = 0;
@@ -67,7 +69,7 @@ struct Drawn
     std::numeric_limits<double>::quiet_NaN() };
   bool Mesh = false; ///< drawn by VTK's polygon pipeline (--mode mesh)
 
-  PictureBuffers Buffers() const { return { Width, Height, &Colour, &Depth }; }
+  PictureBuffers Buffers() const { return { Width, Height, &Colour, &Depth, &Normal }; }
 };
 
 Drawn FromRayCast(render::RayCastResult&& r)
@@ -77,6 +79,7 @@ Drawn FromRayCast(render::RayCastResult&& r)
   d.Height = r.height;
   d.Colour = std::move(r.colour);
   d.Depth = std::move(r.depth);
+  d.Normal = std::move(r.normal);
   d.Covered = r.coveredPixels;
   d.Unresolved = r.unresolvedPixels;
   d.Cut = r.cutPixels;
@@ -92,6 +95,7 @@ Drawn FromComplex(render::ComplexRenderResult&& r)
   d.Height = r.canvas.height;
   d.Colour = std::move(r.canvas.colour);
   d.Depth = std::move(r.canvas.depth);
+  d.Normal = std::move(r.canvas.normal);
   d.Covered = r.pixelsByDimension[0] + r.pixelsByDimension[1] + r.pixelsByDimension[2] +
     r.pixelsByDimension[3];
   d.Unresolved = r.unresolvedPixels;

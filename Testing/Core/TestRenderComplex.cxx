@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -198,7 +199,9 @@ TEST(RenderRasterize, SquareAndSphereCoverTheirAnalyticPixels)
   Primitives square;
   square.points = { { 0, 0, 0.25 }, { 1, 0, 0.25 }, { 1, 1, 0.25 }, { 0, 1, 0.25 },
     { 0.5, 0.5, 0.5 } };
-  square.triangles = { { 0, 1, 2 }, { 0, 2, 3 } };
+  // The second triangle is wound the other way: its normal points away from the eye, and the
+  // normal buffer turns it round.
+  square.triangles = { { 0, 1, 2 }, { 0, 3, 2 } };
   square.spheres = { 4 };
   square.sphereRadius = 0.3;
   square.paints.assign(5, Paint{});
@@ -225,7 +228,11 @@ TEST(RenderRasterize, SquareAndSphereCoverTheirAnalyticPixels)
       if (ballGap < 0)
       {
         ++inBall;
-        EXPECT_NEAR(canvas.depth[p], o[2] - (0.5 + std::sqrt(0.09 - dx * dx - dy * dy)), 1e-12);
+        const double dz = std::sqrt(0.09 - dx * dx - dy * dy);
+        EXPECT_NEAR(canvas.depth[p], o[2] - (0.5 + dz), 1e-12);
+        EXPECT_NEAR(canvas.normal[3 * p + 0], dx / 0.3, 1e-6);
+        EXPECT_NEAR(canvas.normal[3 * p + 1], dy / 0.3, 1e-6);
+        EXPECT_NEAR(canvas.normal[3 * p + 2], dz / 0.3, 1e-6);
         EXPECT_EQ(canvas.colour[4 * p + 0], 0);
         EXPECT_GT(canvas.colour[4 * p + 1], 0);
       }
@@ -233,6 +240,9 @@ TEST(RenderRasterize, SquareAndSphereCoverTheirAnalyticPixels)
       {
         ++inSquare;
         EXPECT_NEAR(canvas.depth[p], o[2] - 0.25, 1e-12);
+        EXPECT_EQ(canvas.normal[3 * p + 0], 0);
+        EXPECT_EQ(canvas.normal[3 * p + 1], 0);
+        EXPECT_EQ(canvas.normal[3 * p + 2], 1);
         // Facing the eye: full light on neutral grey.
         EXPECT_EQ(canvas.colour[4 * p + 0], static_cast<int>(std::lround(255 * NeutralGrey)));
       }
@@ -240,6 +250,7 @@ TEST(RenderRasterize, SquareAndSphereCoverTheirAnalyticPixels)
       {
         EXPECT_EQ(canvas.depth[p], Inf) << i << "," << j;
         EXPECT_EQ(canvas.colour[4 * p + 3], 0);
+        EXPECT_EQ(canvas.normal[3 * p + 2], 0);
       }
     }
   }
@@ -247,6 +258,88 @@ TEST(RenderRasterize, SquareAndSphereCoverTheirAnalyticPixels)
   // disc pi 0.09 of them.
   EXPECT_GT(inSquare + inBall, 250);
   EXPECT_GT(inBall, 60);
+}
+
+TEST(RenderBuffers, OpenGlWindowDepthAndNormalsOfABall)
+{
+  // Seed 003 item 37: the depth buffer in OpenGL's convention ([0, 1], less is nearer) and the
+  // normal buffer, for the ball r^2 - |p|^2 (r = 0.5) seen from (0, 0, 10) down -z, 21 x 21
+  // pixels 0.05 apart (an orthographic height of 1.05; a perspective one of 6 degrees).
+  const Expr p2 = square(Expr::x()) + square(Expr::y()) + square(Expr::z());
+  const TapePtr ball = Tape::compile(Expr(0.25) - p2);
+  const Box3 box{ { -0.6, -0.6, -0.6 }, { 0.6, 0.6, 0.6 } };
+  const std::size_t centre = 10 * 21 + 10, right = 10 * 21 + 16; // (0, 0) and (0.3, 0)
+  {
+    const Camera camera = Camera::lookAt(
+      { 0, 0, 10 }, { 0, 0, 0 }, { 0, 1, 0 }, Projection::Orthographic, 30, 0.525, 21, 21);
+    const RayCastResult r = rayCast(ball, box, camera);
+    ASSERT_EQ(r.normal.size(), 3u * 21 * 21);
+    // Near plane 5, far 15: the top of the ball (z = 0.5, depth 9.5) at (9.5 - 5) / 10; at
+    // x = 0.3 the surface is at z = 0.4 (depth 9.6), its normal (0.6, 0, 0.8).
+    const std::vector<double> w = windowDepth(r.depth, camera, 5, 15);
+    EXPECT_NEAR(w[centre], 0.45, 1e-7);
+    EXPECT_NEAR(w[right], 0.46, 1e-7);
+    EXPECT_EQ(w[0], 1); // the corner sees nothing: the cleared buffer
+    EXPECT_NEAR(r.normal[3 * right + 0], 0.6, 1e-6);
+    EXPECT_NEAR(r.normal[3 * right + 1], 0, 1e-6);
+    EXPECT_NEAR(r.normal[3 * right + 2], 0.8, 1e-6);
+    EXPECT_NEAR(r.normal[3 * centre + 2], 1, 1e-6);
+    EXPECT_EQ(r.normal[0], 0);
+    // Clamped outside the planes (GL's depth clamping), and nearer is less.
+    EXPECT_EQ(windowDepth(r.depth, camera, 9.55, 15)[centre], 0);
+    EXPECT_EQ(windowDepth(r.depth, camera, 5, 9.55)[right], 1);
+    EXPECT_LT(w[centre], w[right]);
+    const std::vector<double> back = depthFromWindow(w, camera, 5, 15);
+    EXPECT_NEAR(back[centre], r.depth[centre], 1e-12);
+    EXPECT_EQ(back[0], Inf);
+  }
+  {
+    const Camera camera =
+      Camera::lookAt({ 0, 0, 10 }, { 0, 0, 0 }, { 0, 1, 0 }, Projection::Perspective, 6, 1, 21, 21);
+    const RayCastResult r = rayCast(ball, box, camera);
+    // Near 1, far 100: window depth = 100 (z - 1) / (99 z) for the depth z along the axis; at the
+    // centre z = 9.5.
+    const std::vector<double> w = windowDepth(r.depth, camera, 1, 100);
+    EXPECT_NEAR(w[centre], 100 * 8.5 / (99 * 9.5), 1e-9);
+    // Off the axis the buffer holds the distance along the ray; the window depth takes the
+    // depth along the axis, z = distance * cos(angle): the hit point's own z.
+    const std::size_t p = right;
+    ASSERT_TRUE(std::isfinite(r.depth[p]));
+    const Point3 d = camera.direction(camera.u(16), camera.v(10));
+    const Point3 hit = add(camera.eye(), scale(d, r.depth[p] / norm(d)));
+    const double z = 10 - hit[2];
+    EXPECT_NEAR(w[p], 100 * (z - 1) / (99 * z), 1e-9);
+    // The normal there is the hit point's direction from the centre, facing the eye.
+    EXPECT_NEAR(r.normal[3 * p + 0], hit[0] / 0.5, 1e-5);
+    EXPECT_NEAR(r.normal[3 * p + 2], hit[2] / 0.5, 1e-5);
+    const std::vector<double> back = depthFromWindow(w, camera, 1, 100);
+    EXPECT_NEAR(back[p], r.depth[p], 1e-9);
+    EXPECT_THROW(windowDepth(r.depth, camera, 0, 100), std::invalid_argument);
+    EXPECT_THROW(windowDepth(r.depth, camera, 5, 5), std::invalid_argument);
+    EXPECT_THROW(windowDepth({ 1.0, 2.0 }, camera, 1, 100), std::invalid_argument);
+  }
+}
+
+TEST(RenderBuffers, RenderersCheckTheCanvasIsForTheCamera)
+{
+  // Item 37's IsValidFor: a canvas of another size, or with a buffer of the wrong length, is
+  // refused before anything is written.
+  const Box3 box{ { -1, -1, -1 }, { 1, 1, 1 } };
+  const Camera camera = Camera::orbit(box, View{ 0, 90, 3 }, Projection::Orthographic, 16, 12);
+  Primitives triangle;
+  triangle.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } };
+  triangle.triangles = { { 0, 1, 2 } };
+  Canvas good(16, 12);
+  EXPECT_TRUE(good.isValidFor(camera));
+  Canvas wide(17, 12);
+  EXPECT_FALSE(wide.isValidFor(camera));
+  EXPECT_THROW(rasterize(wide, camera, triangle), std::invalid_argument);
+  Canvas cut(16, 12);
+  cut.normal.resize(10);
+  EXPECT_FALSE(cut.isValidFor(camera));
+  EXPECT_THROW(rasterize(cut, camera, triangle), std::invalid_argument);
+  EXPECT_TRUE(std::all_of(cut.depth.begin(), cut.depth.end(), [](double d) { return d == Inf; }));
+  EXPECT_GT(rasterize(good, camera, triangle), 0);
 }
 
 TEST(RenderComplex, ScalarAttributeThroughColourMap)

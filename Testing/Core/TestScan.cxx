@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -211,6 +212,15 @@ TEST(Inv3, BadFilesNameTheFileAndTheProblem)
 
   EXPECT_THAT(errorOf([&] { voxel::readInv3(good, "mask_0"); }),
     ::testing::AllOf(HasSubstr(good), HasSubstr("'mask_0'")));
+
+  // A gzip bomb: 64 MiB of zeros in about 64 KiB, refused once the inflated bytes pass the limit
+  // (here 1 MiB), before they are all held. The small project reads under a limit of 4 KiB.
+  const std::string bomb = dir.file("bomb.inv3");
+  writeGzip(bomb, std::string(std::size_t{ 64 } << 20, '\0'));
+  EXPECT_LT(std::filesystem::file_size(bomb), std::uintmax_t{ 1 } << 20);
+  EXPECT_THAT(errorOf([&] { voxel::readInv3(bomb, "", std::uint64_t{ 1 } << 20); }),
+    ::testing::AllOf(HasSubstr(bomb), HasSubstr("inflates to more than 1048576 bytes")));
+  EXPECT_EQ(voxel::readInv3(good, "", 4096)->values.size(), 12u);
 }
 
 /// The head CT the issue-15 study uses (not skipped when missing: the suite needs it).

@@ -4,6 +4,7 @@
 // self-contained file written back, transformations at hand-derived points, colours and object
 // ids as attributes, perturbations through the language, diagnostics with file:line:col, and
 // picking the frontmost object of a picture.
+#include "Discretize/Mesh.h"
 #include "FRep/Evaluators.h"
 #include "FRep/Tape.h"
 #include "Lang/ModelFile.h"
@@ -398,21 +399,71 @@ TEST(Scene, PickAPerturbation)
 
 TEST(Scene, ReRenderingAfterAnEditMakesNoMesh)
 {
-  // Item 36: changing a perturbation factor and rendering again gives a new depth buffer straight
-  // from the field (the ray caster evaluates the tape; there is no mesh to rebuild): the bump of
-  // k = 10 is nearer the camera on +x than that of k = 1 (item 30's fixture: k / 64 in the
-  // language, see PerturbationsThroughTheLanguage).
+  // Item 36: changing a perturbation factor in the scene and rendering again gives a new depth
+  // buffer straight from the field (the ray caster evaluates the tape; there is no mesh to
+  // rebuild), seen by the discretiser's instrumentation counter: no mesh is made by the loop, and
+  // the counter does count the mesh the polygon view of the same scene makes. The bump of k = 10
+  // is nearer the camera on +x than that of k = 1 (item 30's fixture: k / 64 in the language, see
+  // PerturbationsThroughTheLanguage).
   const frep::Box3 box{ { -1.5, -1.5, -1.5 }, { 1.5, 1.5, 1.5 } };
   const render::Camera camera = render::Camera::lookAt(
     { 10, 0, 0 }, { 0, 0, 0 }, { 0, 0, 1 }, render::Projection::Orthographic, 30, 2, 21, 21);
-  const render::RayCastResult k1 = render::rayCast(
-    build("ell { perturb 0.015625 ell { scale 0.5 move 1 0 0 } }").model, box, camera);
-  const render::RayCastResult k10 = render::rayCast(
-    build("ell { perturb 0.15625 ell { scale 0.5 move 1 0 0 } }").model, box, camera);
+  lang::Scene scene =
+    lang::parseScene("ell { perturb 0.015625 ell { scale 0.5 move 1 0 0 } }", "edit.scn", nullptr);
   const std::size_t centre = 10 * 21 + 10;
+  const std::int64_t meshesBefore = discretize::meshesMade();
+  const render::RayCastResult k1 = render::rayCast(lang::buildScene(scene).model, box, camera);
+  scene.objects[0].perturbations[0].factor = 0.15625; // the edit
+  const render::RayCastResult k10 = render::rayCast(lang::buildScene(scene).model, box, camera);
+  EXPECT_EQ(discretize::meshesMade(), meshesBefore);
   EXPECT_NEAR(k1.depth[centre], 10 - 1.0077766, 1e-5);
   EXPECT_NEAR(k10.depth[centre], 10 - 1.0709777, 1e-5);
   EXPECT_GT(k10.pointEvaluations, 0);
+  EXPECT_GT(k10.intervalEvaluations, 0);
+  // The counter is live: the polygon view (`ictk render --mode mesh`) tessellates.
+  const render::ScenePrimitives polygons =
+    render::modelScene(lang::buildScene(scene).model, box, 0.1);
+  EXPECT_GT(discretize::meshesMade(), meshesBefore);
+}
+
+TEST(Scene, ObjectsAreReleasedWithTheirLastReference)
+{
+  // Item 39 (AddRef/Release, std::shared_ptr semantics): a built scene's expression nodes are
+  // shared by reference counting. They live while the model (or a copy) holds them, and go when
+  // the count reaches 0: with the last copy, or when the holder is assigned another scene, whose
+  // nodes then are all that remain. A tape compiled from the model holds no node. The edit loop of
+  // item 36 therefore keeps one scene's nodes alive, however long it runs.
+  const std::string ball = "ell { perturb 0.015625 ell { scale 0.5 move 1 0 0 } }\n";
+  const std::string cone = "inter { cone layer { scale 1 1 0.5 } color 1 0 0 move 3 0 0 }\n";
+  const std::size_t before = frep::Expr::liveNodeCount();
+  std::size_t ballNodes = 0;
+  {
+    lang::BuiltScene s = build(ball);
+    ballNodes = frep::Expr::liveNodeCount() - before;
+    EXPECT_GT(ballNodes, 20u);
+    const lang::BuiltScene copy = s; // a second reference to the same nodes, not new ones
+    EXPECT_EQ(frep::Expr::liveNodeCount(), before + ballNodes);
+    s = build(cone); // the ball's nodes stay: `copy` holds them
+    const std::size_t both = frep::Expr::liveNodeCount();
+    EXPECT_GT(both, before + ballNodes);
+    s = build(ball); // hash-consing: the same nodes as `copy`'s
+    EXPECT_EQ(frep::Expr::liveNodeCount(), before + ballNodes);
+  }
+  EXPECT_EQ(frep::Expr::liveNodeCount(), before);
+  {
+    const frep::TapePtr tape = build(cone).model.compile();
+    EXPECT_EQ(frep::Expr::liveNodeCount(), before); // the scene went; its tape holds no node
+    EXPECT_GT(tape->instructions().size(), 10u);
+  }
+  // The edit loop: every factor is a new constant and new nodes above it; the previous ones go.
+  lang::Scene scene = lang::parseScene(ball, "edit.scn", nullptr);
+  lang::BuiltScene built = lang::buildScene(scene);
+  for (int k = 1; k <= 100; ++k)
+  {
+    scene.objects[0].perturbations[0].factor = k / 64.0;
+    built = lang::buildScene(scene);
+    EXPECT_LE(frep::Expr::liveNodeCount(), before + ballNodes + 2) << k;
+  }
 }
 
 TEST(Scene, DocsTypeTable)

@@ -307,8 +307,18 @@ def read_depth(path):
     r = vtk.vtkXMLImageDataReader()
     r.SetFileName(path)
     r.Update()
-    a = r.GetOutput().GetPointData().GetArray("depth")
-    return [a.GetValue(i) for i in range(a.GetNumberOfTuples())]
+    data = r.GetOutput().GetPointData()
+    a = data.GetArray("depth")
+    depth = [a.GetValue(i) for i in range(a.GetNumberOfTuples())]
+    # The normal buffer (seed 003 item 37), when the renderer gives one: unit normals where a
+    # surface is, zero on the background.
+    n = data.GetArray("normal")
+    if n is not None:
+        for i, d in enumerate(depth):
+            length = math.sqrt(sum(c * c for c in n.GetTuple3(i)))
+            if abs(length - (1 if math.isfinite(d) else 0)) > 1e-5:
+                sys.exit(f"FAIL: {path}: pixel {i}'s normal has length {length} (depth {d})")
+    return depth, n is not None
 
 
 def compare_modes(ictk, work, name, model, w, h, view, threshold_off=0.005):
@@ -322,7 +332,10 @@ def compare_modes(ictk, work, name, model, w, h, view, threshold_off=0.005):
                     os.path.join(work, f"{name}-{mode}.vti"))
         run(ictk, ["render", model, "-o", png, "--depth", vti, "--size", f"{w},{h}",
                    "--view", view, "--mode", mode])
-        depth[mode] = read_depth(vti)
+        depth[mode], normals = read_depth(vti)
+        if normals != (mode == "raycast"):
+            sys.exit(f"FAIL: {name}: the {mode} depth file {'lacks' if not normals else 'has'} "
+                     "a normal buffer")
     ray, mesh = depth["raycast"], depth["mesh"]
     agree = sum(1 for a, b in zip(ray, mesh) if math.isfinite(a) == math.isfinite(b))
     print(f"{name}: coverage agrees on {agree} of {w * h} pixels")

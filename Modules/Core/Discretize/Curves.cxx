@@ -642,6 +642,7 @@ CurveSet traceCurve(const frep::Field& g1, const frep::Field& g2,
   const std::vector<frep::FieldPtr>& trims, const Box3& box, const CurveOptions& options)
 {
   Tracer tracer(g1, &g2, trims, box, options, "traceCurve");
+  detail::countMeshMade();
   return tracer.run();
 }
 
@@ -649,6 +650,7 @@ CurveSet traceCurve2D(const frep::Field& g, const std::vector<frep::FieldPtr>& t
   const Box3& box, const CurveOptions& options)
 {
   Tracer tracer(g, nullptr, trims, box, options, "traceCurve2D");
+  detail::countMeshMade();
   return tracer.run();
 }
 

@@ -96,6 +96,7 @@ struct BlockResult
 SurfaceMesh marchingTetrahedra(const frep::Field& field, const Box3& box, const ContourOptions& o)
 {
   checkBox(box, o.featureSize, "marchingTetrahedra");
+  detail::countMeshMade();
   const double h = o.featureSize;
   std::array<std::int64_t, 3> cells;
   double total = 1;

@@ -5,6 +5,7 @@
 #include "FRep/Vector.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -14,6 +15,8 @@ namespace ictk::discretize
 {
 namespace
 {
+
+std::atomic<std::int64_t> meshCount{ 0 };
 
 struct UnionFind
 {
@@ -246,6 +249,16 @@ double enclosedVolume(const SurfaceMesh& mesh)
     volume += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
   }
   return volume;
+}
+
+std::int64_t meshesMade()
+{
+  return meshCount.load(std::memory_order_relaxed);
+}
+
+void detail::countMeshMade()
+{
+  meshCount.fetch_add(1, std::memory_order_relaxed);
 }
 
 } // namespace ictk::discretize

@@ -77,4 +77,15 @@ MeshTopology analyzeTopology(const SurfaceMesh& mesh);
 double surfaceArea(const SurfaceMesh& mesh);
 double enclosedVolume(const SurfaceMesh& mesh);
 
+/// Instrumentation: how many meshes (surfaces, trimmed patches, curve sets) this module's
+/// algorithms have made in the process so far. Seed 003 item 36 asks that editing a scene and
+/// ray casting it again makes none; the counter is how a test sees that. Thread safe.
+std::int64_t meshesMade();
+
+namespace detail
+{
+/// Counts one mesh made; called once by every public function of the module that makes one.
+void countMeshMade();
+} // namespace detail
+
 } // namespace ictk::discretize

@@ -57,6 +57,7 @@ MaterialSurface multiMaterialSurface(const std::vector<frep::FieldPtr>& solids,
   const std::vector<double>& priorities, const Box3& box, double size,
   const MultiMaterialOptions& o)
 {
+  detail::countMeshMade();
   for (int a = 0; a < 3; ++a)
   {
     if (!std::isfinite(box.lo[a]) || !std::isfinite(box.hi[a]) || !(box.lo[a] < box.hi[a]))

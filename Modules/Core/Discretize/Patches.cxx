@@ -75,6 +75,7 @@ void mapPoints(Points& points, std::vector<PointArray>& pointData, const frep::F
 SurfaceMesh trimSurface(const SurfaceMesh& carrierMesh, const frep::Field& carrier,
   const std::vector<frep::FieldPtr>& trims, const TrimOptions& options)
 {
+  detail::countMeshMade();
   checkFields(trims, "trimSurface");
   checkNewton(options.tolerance, options.maxIterations, "trimSurface");
   checkPointData(carrierMesh.pointData, carrierMesh.points.size(), "trimSurface");
@@ -101,6 +102,7 @@ SurfaceMesh triangulateRegion2D(
   const frep::Field& f, const Box3& box, const Region2DOptions& options)
 {
   const char* what = "triangulateRegion2D";
+  detail::countMeshMade();
   checkBox(box, 4u, what);
   checkNewton(options.tolerance, options.maxIterations, what);
   if (!(options.size > 0) || !std::isfinite(options.size))

@@ -182,6 +182,7 @@ void SurfaceMemory::clear()
 SurfaceMesh contourSurface(
   const frep::Field& field, const frep::Box3& box, const SurfaceOptions& options)
 {
+  detail::countMeshMade();
   const Layout layout = makeLayout(box, options);
   caseTable(); // built once, before the threads need it
 

@@ -124,6 +124,18 @@ NodeTable& nodeTable()
 }
 } // namespace
 
+std::size_t Expr::liveNodeCount()
+{
+  NodeTable& table = nodeTable();
+  std::lock_guard<std::recursive_mutex> lock(table.mutex);
+  std::size_t live = 0;
+  for (const auto& entry : table.nodes)
+  {
+    live += entry.second.expired() ? 0 : 1;
+  }
+  return live;
+}
+
 Node::~Node()
 {
   {

@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace ictk::render
 {
@@ -103,6 +105,7 @@ Canvas::Canvas(int w, int h, Colouring c)
     colour[4 * p + 3] = 0;
   }
   owner.assign(pixels, -1);
+  normal.assign(3 * pixels, 0.0f);
   if (c == Colouring::Scalar)
   {
     scalar.assign(pixels, std::numeric_limits<float>::quiet_NaN());
@@ -110,7 +113,17 @@ Canvas::Canvas(int w, int h, Colouring c)
   }
 }
 
-bool Canvas::put(std::size_t p, double d, double l, const Paint& paint, std::int32_t who)
+bool Canvas::isValidFor(const Camera& camera) const
+{
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  const bool scalars =
+    colouring != Colouring::Scalar || (scalar.size() == pixels && light.size() == pixels);
+  return width == camera.width() && height == camera.height() && depth.size() == pixels &&
+    colour.size() == 4 * pixels && owner.size() == pixels && normal.size() == 3 * pixels && scalars;
+}
+
+bool Canvas::put(std::size_t p, double d, double l, const Paint& paint, std::int32_t who,
+  const frep::Point3& n, const frep::Point3& direction)
 {
   if (!(d < depth[p]))
   {
@@ -118,6 +131,14 @@ bool Canvas::put(std::size_t p, double d, double l, const Paint& paint, std::int
   }
   depth[p] = d;
   owner[p] = who;
+  const double length = frep::norm(n);
+  const double side = frep::dot(n, direction) > 0 ? -1 : 1;
+  for (int c = 0; c < 3; ++c)
+  {
+    normal[3 * p + static_cast<std::size_t>(c)] = length > 0 && std::isfinite(length)
+      ? static_cast<float>(side * n[static_cast<std::size_t>(c)] / length)
+      : 0.0f;
+  }
   std::uint8_t* rgba = &colour[4 * p];
   if (colouring == Colouring::Scalar)
   {
@@ -134,6 +155,74 @@ bool Canvas::put(std::size_t p, double d, double l, const Paint& paint, std::int
   }
   rgba[3] = 255;
   return true;
+}
+
+namespace
+{
+/// Checks the planes and the buffer's size for windowDepth and depthFromWindow.
+void checkDepthPlanes(
+  const char* what, std::size_t pixels, const Camera& camera, double near, double far)
+{
+  const bool perspective = camera.projection() == Projection::Perspective;
+  if (!std::isfinite(near) || !std::isfinite(far) || !(near < far) || (perspective && !(near > 0)))
+  {
+    throw std::invalid_argument(std::string(what) +
+      (perspective ? ": the planes must be finite with 0 < near < far"
+                   : ": the planes must be finite with near < far"));
+  }
+  if (pixels !=
+    static_cast<std::size_t>(camera.width()) * static_cast<std::size_t>(camera.height()))
+  {
+    throw std::invalid_argument(std::string(what) + ": the buffer is not of the camera's size");
+  }
+}
+
+/// The length of pixel p's ray direction: its distance is its depth along the viewing axis times
+/// this (Camera.h: the direction has a unit component along the axis; 1 for an orthographic ray).
+double rayStretch(const Camera& camera, std::size_t p)
+{
+  const std::size_t w = static_cast<std::size_t>(camera.width());
+  return frep::norm(
+    camera.direction(camera.u(static_cast<double>(p % w)), camera.v(static_cast<double>(p / w))));
+}
+} // namespace
+
+std::vector<double> windowDepth(
+  const std::vector<double>& depth, const Camera& camera, double near, double far)
+{
+  checkDepthPlanes("windowDepth", depth.size(), camera, near, far);
+  const bool perspective = camera.projection() == Projection::Perspective;
+  std::vector<double> window(depth.size(), 1.0);
+  for (std::size_t p = 0; p < depth.size(); ++p)
+  {
+    if (std::isfinite(depth[p]))
+    {
+      const double z = depth[p] / rayStretch(camera, p);
+      const double d =
+        perspective ? far * (z - near) / (z * (far - near)) : (z - near) / (far - near);
+      window[p] = std::clamp(d, 0.0, 1.0);
+    }
+  }
+  return window;
+}
+
+std::vector<double> depthFromWindow(
+  const std::vector<double>& window, const Camera& camera, double near, double far)
+{
+  checkDepthPlanes("depthFromWindow", window.size(), camera, near, far);
+  const bool perspective = camera.projection() == Projection::Perspective;
+  std::vector<double> depth(window.size(), std::numeric_limits<double>::infinity());
+  for (std::size_t p = 0; p < window.size(); ++p)
+  {
+    const double d = window[p];
+    if (d < 1)
+    {
+      const double z =
+        perspective ? far * near / (far - d * (far - near)) : near + d * (far - near);
+      depth[p] = z * rayStretch(camera, p);
+    }
+  }
+  return depth;
 }
 
 std::int64_t Canvas::covered() const

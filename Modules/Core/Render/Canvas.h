@@ -14,6 +14,7 @@
 // is in, over the range of the values seen or a given one.
 
 #include "FRep/Vector.h"
+#include "Render/Camera.h"
 
 #include <array>
 #include <cstdint>
@@ -94,6 +95,10 @@ struct Canvas
   std::vector<std::uint8_t> colour;
   /// Who drew each pixel (a cell id, or 0 for a lone model); -1: background.
   std::vector<std::int32_t> owner;
+  /// The unit normal of the surface at each pixel, in model coordinates, turned to face the
+  /// camera (3 values a pixel; 0, 0, 0 for the background or a surface with no normal there):
+  /// seed 003's normal buffer (papers.md 5.B item 37).
+  std::vector<float> normal;
   /// Colouring by a scalar: its value and the light per pixel.
   std::vector<float> scalar;
   std::vector<float> light;
@@ -103,9 +108,15 @@ struct Canvas
     return static_cast<std::size_t>(j) * static_cast<std::size_t>(width) +
       static_cast<std::size_t>(i);
   }
+  /// Whether the buffers are those of `camera`'s picture: its width and height, each buffer of
+  /// that many pixels (seed 003's IsValidFor). Every renderer checks it before writing.
+  bool isValidFor(const Camera& camera) const;
   /// Records a surface at pixel `index` when it is nearer than what is there (ties keep the
-  /// first); returns whether it was recorded. Pixels are written by one thread each.
-  bool put(std::size_t index, double depth, double light, const Paint& paint, std::int32_t owner);
+  /// first); returns whether it was recorded. `normal` is the surface's normal (any length and
+  /// side; zero or not finite when it has none), `direction` the pixel's ray, which it is turned
+  /// against. Pixels are written by one thread each.
+  bool put(std::size_t index, double depth, double light, const Paint& paint, std::int32_t owner,
+    const frep::Point3& normal, const frep::Point3& direction);
   /// The pixels covered by a surface.
   std::int64_t covered() const;
   /// The smallest and largest scalar of the covered pixels (NaN, NaN when there is none).
@@ -114,6 +125,21 @@ struct Canvas
   /// the middle of the map), shaded by its light; undefined values are neutral grey.
   void applyColourMap(const ColourMap& map, double lo, double hi);
 };
+
+/// A depth buffer (distances along the pixels' rays, as Canvas::depth) in OpenGL's convention
+/// (seed 003 item 37): window depth in [0, 1], less is nearer, for near and far planes at depths
+/// `near` and `far` along the camera's viewing axis. With z a surface's depth along that axis,
+/// a perspective camera gives far (z - near) / (z (far - near)) (0 < near < far), an orthographic
+/// one (z - near) / (far - near) (near < far); the background is 1 (the cleared buffer), and a
+/// surface in front of near or behind far is clamped to 0 or 1 (OpenGL's depth clamping).
+/// Throws std::invalid_argument for planes out of range or a buffer not of the camera's size.
+std::vector<double> windowDepth(
+  const std::vector<double>& depth, const Camera& camera, double near, double far);
+/// The inverse of windowDepth: distances along the pixels' rays from OpenGL window depths (a
+/// z-buffer read back from VTK or OpenGL with the same planes); +infinity where the window depth
+/// is 1 or more (the cleared buffer). Throws as windowDepth.
+std::vector<double> depthFromWindow(
+  const std::vector<double>& window, const Camera& camera, double near, double far);
 
 /// Colours a picture coloured by a scalar with the options' map over their range (its NaN ends
 /// from the values seen; [0, 1] when none is seen) and returns that range. Throws

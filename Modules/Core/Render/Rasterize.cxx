@@ -240,9 +240,10 @@ Paint paintOf(const Primitives& p, const Hit& hit)
 
 void check(const Canvas& canvas, const Camera& camera, const Primitives& p)
 {
-  if (canvas.width != camera.width() || canvas.height != camera.height())
+  if (!canvas.isValidFor(camera))
   {
-    throw std::invalid_argument("rasterize: the canvas and the camera differ in size");
+    throw std::invalid_argument("rasterize: the canvas is not the camera's picture (its size or "
+                                "buffers differ)");
   }
   const std::size_t n = p.points.size();
   for (const Point3& q : p.points)
@@ -390,8 +391,8 @@ std::int64_t rasterize(
               break;
           }
           if (hit.t < canvas.depth[canvas.index(i, j)] &&
-            canvas.put(
-              canvas.index(i, j), hit.t, headlight(hit.normal, d, 1), paintOf(p, hit), p.owner))
+            canvas.put(canvas.index(i, j), hit.t, headlight(hit.normal, d, 1), paintOf(p, hit),
+              p.owner, hit.normal, d))
           {
             ++count;
           }

@@ -691,7 +691,10 @@ private:
       normal = stage.gradient(ray.at(s));
     }
     const double light = headlight(normal, ray.direction, ray.length);
-    if (!canvas_.put(canvas_.index(ray.i, ray.j), s * ray.length, light, paint, solid_.owner))
+    // The normal buffer takes the outward normal, -gradient (f >= 0 inside).
+    const frep::Point3 outward{ -normal[0], -normal[1], -normal[2] };
+    if (!canvas_.put(canvas_.index(ray.i, ray.j), s * ray.length, light, paint, solid_.owner,
+          outward, ray.direction))
     {
       return false;
     }
@@ -802,6 +805,7 @@ RayCastResult castModel(const TapePtr& tape, const frep::Hypervolume* model, con
   result.height = canvas.height;
   result.colour = std::move(canvas.colour);
   result.depth = std::move(canvas.depth);
+  result.normal = std::move(canvas.normal);
   result.coveredPixels = counts.covered;
   result.unresolvedPixels = counts.unresolved;
   result.cutPixels = counts.cut;
@@ -836,9 +840,10 @@ CastCounts cast(
   {
     throw std::invalid_argument("rayCast: the time must be finite");
   }
-  if (canvas.width != camera.width() || canvas.height != camera.height())
+  if (!canvas.isValidFor(camera))
   {
-    throw std::invalid_argument("rayCast: the canvas and the camera differ in size");
+    throw std::invalid_argument("rayCast: the canvas is not the camera's picture (its size or "
+                                "buffers differ)");
   }
   return RayCaster(canvas, solid, camera, options).run();
 }

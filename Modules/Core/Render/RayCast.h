@@ -109,6 +109,8 @@ struct RayCastResult
   /// Distance along the pixel's ray from the camera's eye (perspective) or image plane
   /// (orthographic) to the surface; +infinity where nothing is hit.
   std::vector<double> depth;
+  /// The surface's unit normal turned to face the camera, 3 values a pixel (Canvas::normal).
+  std::vector<float> normal;
   std::int64_t coveredPixels = 0;
   /// Covered because a piece no longer than the depth tolerance could not be excluded (see the
   /// file comment); a subset of coveredPixels.

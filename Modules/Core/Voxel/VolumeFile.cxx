@@ -30,8 +30,9 @@ std::string quoted(const std::string& path)
 }
 
 /// The whole gzip stream of `path`, inflated; a stream that stops before its end is an error
-/// (a truncated download or copy), not a short scan.
-std::string gunzip(const std::string& path)
+/// (a truncated download or copy), not a short scan, and so is one that inflates to more than
+/// `limit` bytes.
+std::string gunzip(const std::string& path, std::uint64_t limit)
 {
   std::ifstream in(path, std::ios::binary);
   if (!in)
@@ -51,7 +52,7 @@ std::string gunzip(const std::string& path)
     throw std::runtime_error(quoted(path) + ": zlib could not start inflating");
   }
   std::string out;
-  out.resize(packed.size() * 3);
+  out.resize(static_cast<std::size_t>(std::min<std::uint64_t>(limit, packed.size() * 3)));
   z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(packed.data()));
   z.avail_in = static_cast<uInt>(packed.size());
   int status = Z_OK;
@@ -60,7 +61,14 @@ std::string gunzip(const std::string& path)
   {
     if (produced == out.size())
     {
-      out.resize(out.size() * 2);
+      if (produced >= limit)
+      {
+        inflateEnd(&z);
+        throw std::runtime_error(quoted(path) + ": the archive inflates to more than " +
+          std::to_string(limit) + " bytes (damaged, or not a scan ICTK should hold in memory)");
+      }
+      out.resize(static_cast<std::size_t>(
+        std::min<std::uint64_t>(limit, std::max<std::uint64_t>(2 * out.size(), 1024))));
     }
     z.next_out = reinterpret_cast<Bytef*>(&out[produced]);
     z.avail_out = static_cast<uInt>(out.size() - produced);
@@ -324,14 +332,15 @@ std::shared_ptr<VoxelGrid> readCoreVolume(const std::string& path, const std::st
     quoted(path) + ": the core reads .vdb and .inv3 volumes (others through the VTK layer)");
 }
 
-std::shared_ptr<VoxelGrid> readInv3(const std::string& path, const std::string& array)
+std::shared_ptr<VoxelGrid> readInv3(
+  const std::string& path, const std::string& array, std::uint64_t maxInflatedBytes)
 {
   if (!array.empty() && array != "matrix")
   {
     throw std::runtime_error(
       quoted(path) + ": an InVesalius project has one scan, \"matrix\" (not '" + array + "')");
   }
-  const auto files = untar(gunzip(path), path);
+  const auto files = untar(gunzip(path, maxInflatedBytes), path);
   const auto mainPlist = files.find("main.plist");
   if (mainPlist == files.end())
   {

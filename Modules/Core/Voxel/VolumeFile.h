@@ -13,6 +13,7 @@
 
 #include "Voxel/VoxelGrid.h"
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -26,13 +27,19 @@ bool isCoreVolume(const std::string& path);
 /// std::invalid_argument for another extension.
 std::shared_ptr<VoxelGrid> readCoreVolume(const std::string& path, const std::string& array = "");
 
+/// The most an .inv3 archive may inflate to: 8 GiB, four times a 1024 x 1024 x 1024 scan of
+/// 16-bit values, far above any clinical CT or MRI.
+constexpr std::uint64_t MaxInv3Bytes = std::uint64_t{ 8 } << 30;
+
 /// Reads the scan of an InVesalius project. `array` is "" or "matrix" (the scan; InVesalius's
 /// masks and surfaces are not read). dtypes int16, uint16, int8, uint8 and float32 are converted
 /// to float. Throws std::runtime_error naming the file for a missing or unreadable file, data
 /// that is not gzip or is cut short, a tar without main.plist or without the matrix file, a plist
 /// without a valid "matrix" (dtype, filename, shape) or "spacing", an unsupported dtype, and a
 /// matrix whose byte count differs from what its shape and dtype need (both counts in the
-/// message).
-std::shared_ptr<VoxelGrid> readInv3(const std::string& path, const std::string& array = "");
+/// message), and an archive that inflates to more than `maxInflatedBytes` (a damaged file or a
+/// gzip bomb: it is refused before it fills the memory).
+std::shared_ptr<VoxelGrid> readInv3(const std::string& path, const std::string& array = "",
+  std::uint64_t maxInflatedBytes = MaxInv3Bytes);
 
 } // namespace ictk::voxel
