@@ -73,8 +73,7 @@ CLI::Option* AddParams(CLI::App* command, std::string& params)
 
 CLI::Option* AddTime(CLI::App* command, double& time)
 {
-  return command->add_option(
-    "--time", time,
+  return command->add_option("--time", time,
     "Time t (default 0; a .icm model's default is its start, and an animated .blob has no "
     "default and needs it)");
 }
