@@ -483,13 +483,20 @@ private:
     Point3 lo, hi;
     lo.fill(std::numeric_limits<double>::infinity());
     hi.fill(-std::numeric_limits<double>::infinity());
-    for (int k = 0; k < 8; ++k)
+    // Camera::point(u, v, s) at the 8 corners, each ray's origin and direction made once: the
+    // same arithmetic, so the same points bit for bit.
+    for (int k = 0; k < 4; ++k)
     {
-      const Point3 p = camera_.point(u[k & 1], v[(k >> 1) & 1], (k & 4) ? s1 : s0);
-      for (int a = 0; a < 3; ++a)
+      const Point3 o = camera_.origin(u[k & 1], v[k >> 1]);
+      const Point3 d = camera_.direction(u[k & 1], v[k >> 1]);
+      for (const double s : { s0, s1 })
       {
-        lo[a] = std::min(lo[a], p[a]);
-        hi[a] = std::max(hi[a], p[a]);
+        const Point3 p = frep::add(o, frep::scale(d, s));
+        for (int a = 0; a < 3; ++a)
+        {
+          lo[a] = std::min(lo[a], p[a]);
+          hi[a] = std::max(hi[a], p[a]);
+        }
       }
     }
     return mayHold(ws, stage, lo, hi);
