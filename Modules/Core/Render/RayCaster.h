@@ -32,6 +32,8 @@ public:
   /// stage's next narrowed() (the quadtree asks a stage again only for a sibling node, when the
   /// stage it got for the last one is no longer in use).
   virtual Stage* narrowed() = 0;
+  /// May drop the stages narrowed() keeps for reuse (called when none of them is in use).
+  virtual void forget() {}
   virtual double value(const frep::Point3& p) = 0;
   virtual frep::Point3 gradient(const frep::Point3& p) = 0;
 };
