@@ -283,7 +283,7 @@ struct Workspace
   std::vector<std::uint8_t> done; // the current tile's pixels that found their surface
   std::size_t doneCount = 0;      // how many
   /// The same per row of a tile at most 64 pixels wide, bit i for column tile.i0 + i: a node's
-  /// pixels still to be found are then a few masks, not a scan of its pixels (which was 6 % of
+  /// pixels still to be found are then a few masks, not a scan of its pixels (1 % of
   /// render-sphere-gyroid's instructions).
   std::vector<std::uint64_t> doneRows;
   /// Per pixel of the tile: the depth of the first piece that was left unresolved (NaN: none).
