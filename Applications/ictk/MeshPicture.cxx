@@ -93,11 +93,9 @@ void CheckMeshDisplay()
   }
 }
 
-render::Canvas DrawMeshes(const render::ScenePrimitives& scene, const render::Camera& camera,
-  const render::ColourOptions& colours)
+std::array<double, 2> MeshColourRange(
+  const render::ScenePrimitives& scene, const render::ColourOptions& colours)
 {
-  CheckMeshDisplay();
-  const render::ColourMap map = render::ColourMap::named(colours.map);
   std::array<double, 2> range = colours.range;
   if (scene.scalar && (std::isnan(range[0]) || std::isnan(range[1])))
   {
@@ -116,6 +114,15 @@ render::Canvas DrawMeshes(const render::ScenePrimitives& scene, const render::Ca
     range = { std::isnan(range[0]) ? (lo <= hi ? lo : 0.0) : range[0],
       std::isnan(range[1]) ? (lo <= hi ? hi : 1.0) : range[1] };
   }
+  return range;
+}
+
+render::Canvas DrawMeshes(const render::ScenePrimitives& scene, const render::Camera& camera,
+  const render::ColourOptions& colours)
+{
+  CheckMeshDisplay();
+  const render::ColourMap map = render::ColourMap::named(colours.map);
+  const std::array<double, 2> range = MeshColourRange(scene, colours);
 
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);

@@ -11,11 +11,18 @@
 #include "Render/Canvas.h"
 #include "Render/ComplexRender.h"
 
+#include <array>
+
 namespace ictk::cli
 {
 
 /// Throws UserError when there is no X display to render with.
 void CheckMeshDisplay();
+
+/// The values at the colour map's ends when the scene is painted by a scalar: --range's, or the
+/// range of the scene's paints (not only of those in view, unlike the ray caster's).
+std::array<double, 2> MeshColourRange(
+  const render::ScenePrimitives& scene, const render::ColourOptions& colours);
 
 /// Draws the scene (CheckMeshDisplay first).
 render::Canvas DrawMeshes(const render::ScenePrimitives& scene, const render::Camera& camera,

@@ -2,7 +2,8 @@
 // `ictk render`: pictures drawn by the core (Render/): an FRep model (a registered name, .hf,
 // .xml, .vm) ray cast; a complex (.json) or a dynamic model (.icm at --time) with its cells of
 // every dimension composed through one depth buffer (Render/ComplexRender.h); a tetrahedral mesh
-// (.vtu) by the faces of its elements, cut open by --cut (Render/TetCut.h); and with --frames,
+// (.vtu) by the faces of its elements, cut open by --cut (Render/TetCut.h), rasterised or, with
+// --mode mesh, through VTK's OpenGL pipeline; and with --frames,
 // a range of frames of an XYZT model or a .icm model as numbered PNGs or an .mp4 film. This
 // file resolves the input, the camera and the colours; Pictures.h writes the results.
 #include "Command.h"
@@ -160,7 +161,8 @@ public:
     render->add_option("--colour-by", this->ColourBy,
       "The attribute that colours the picture: a colour (3 components) or a scalar drawn "
       "through --colour-map (default: the attribute `colour`, if any); for a .vtu mesh a cell "
-      "or point array of 1 component (MaterialId, youngs_modulus, von_mises, ...)");
+      "or point array of 1 component (MaterialId, youngs_modulus, von_mises, ...; default: the "
+      "cell array MaterialId or label, if any)");
     render->add_option("--cut", this->Cut,
       "nx,ny,nz,d: a .vtu tetrahedral mesh cut open by the plane n . x = d: the tetrahedra "
       "whose centroid has n . x > d are left out, the others kept whole and seen by their "
@@ -180,8 +182,8 @@ public:
       "1/64 of the complex's largest side)");
     render->add_option("--mode", this->Mode,
       "raycast (default: solids ray cast exactly, meshed cells rasterised exactly) or mesh "
-      "(a model's dual-contoured surface, every cell's discretisation, through VTK's OpenGL "
-      "pipeline offscreen; needs an X display or xvfb-run)");
+      "(a model's dual-contoured surface, every cell's discretisation, a .vtu mesh's faces, "
+      "through VTK's OpenGL pipeline offscreen; needs an X display or xvfb-run)");
     render->add_option("--pick", this->PickAt,
       "X,Y: also print what the picture shows at pixel column X (from the left) and row Y (from "
       "the top): the surface point, its depth and, for a scene (.scn), the id of the frontmost "
@@ -201,11 +203,11 @@ public:
     if (tetMesh)
     {
       if (!this->Bounds.empty() || this->TimeOption->count() > 0 || !this->Frames.empty() ||
-        this->Mode != "raycast" || !this->PickAt.empty())
+        !this->PickAt.empty())
       {
         throw UserError("render: '" + this->Model +
-          "' is a tetrahedral mesh: --bounds, --time, --frames, --mode mesh and --pick are for "
-          "models and complexes (a mesh is cut open by --cut)");
+          "' is a tetrahedral mesh: --bounds, --time, --frames and --pick are for models and "
+          "complexes (a mesh is cut open by --cut)");
       }
       InterruptScope interrupts;
       try
@@ -305,7 +307,7 @@ private:
     {
       throw UserError("--mode must be raycast or mesh, got '" + this->Mode + "'");
     }
-    if (this->Mode == "mesh" && !HasExtension(this->Model, ".vtu"))
+    if (this->Mode == "mesh")
     {
       CheckMeshDisplay();
     }
@@ -715,13 +717,27 @@ private:
       throw UserError(std::string("render: ") + e.what());
     }
     render::TetPaint paint;
-    if (!this->ColourBy.empty())
+    // Without --colour-by, a mesh shows its materials: what a user opens a mesh of several to see.
+    std::string colourBy = this->ColourBy;
+    if (colourBy.empty())
     {
-      vtkDataArray* a = grid->GetCellData()->GetArray(this->ColourBy.c_str());
+      for (const char* label : { "MaterialId", "label" })
+      {
+        vtkDataArray* a = grid->GetCellData()->GetArray(label);
+        if (a && a->GetNumberOfComponents() == 1)
+        {
+          colourBy = label;
+          break;
+        }
+      }
+    }
+    if (!colourBy.empty())
+    {
+      vtkDataArray* a = grid->GetCellData()->GetArray(colourBy.c_str());
       const bool perTetrahedron = a != nullptr;
       if (!a)
       {
-        a = grid->GetPointData()->GetArray(this->ColourBy.c_str());
+        a = grid->GetPointData()->GetArray(colourBy.c_str());
       }
       if (!a)
       {
@@ -738,12 +754,12 @@ private:
           }
         }
         throw UserError("--colour-by: '" + this->Model + "' has no cell or point array '" +
-          this->ColourBy + "' (it has: " + (known.empty() ? std::string("none") : known) + ")");
+          colourBy + "' (it has: " + (known.empty() ? std::string("none") : known) + ")");
       }
       if (a->GetNumberOfComponents() != 1)
       {
-        throw UserError("--colour-by: the array '" + this->ColourBy + "' of '" + this->Model +
-          "' has " + std::to_string(a->GetNumberOfComponents()) +
+        throw UserError("--colour-by: the array '" + colourBy + "' of '" + this->Model + "' has " +
+          std::to_string(a->GetNumberOfComponents()) +
           " components; a mesh is coloured by a scalar (1 component)");
       }
       std::vector<double>& values = perTetrahedron ? paint.perTetrahedron : paint.perPoint;
@@ -769,7 +785,21 @@ private:
       [&]
       {
         const render::TetFaces faces = render::tetrahedronFaces(m.points, m.tetrahedra, cut);
+        this->KeptTetrahedra = faces.keptTetrahedra;
         const bool scalar = !paint.perPoint.empty() || !paint.perTetrahedron.empty();
+        if (this->Mode == "mesh")
+        {
+          // The same faces and paints, drawn by VTK's OpenGL pipeline (the reference picture).
+          render::ScenePrimitives scene;
+          scene.scalar = scalar;
+          scene.meshed.push_back(render::tetrahedronFacePrimitives(m.points, faces, paint));
+          Drawn d = FromCanvas(DrawMeshes(scene, camera, this->Colours));
+          if (scalar)
+          {
+            d.ScalarRange = MeshColourRange(scene, this->Colours);
+          }
+          return d;
+        }
         render::Canvas canvas(this->Width, this->Height,
           scalar ? render::Canvas::Colouring::Scalar : render::Canvas::Colouring::Rgb);
         render::RasterOptions options;
@@ -789,7 +819,6 @@ private:
         }
         Drawn d = FromCanvas(std::move(canvas));
         d.ScalarRange = range;
-        this->KeptTetrahedra = faces.keptTetrahedra;
         return d;
       });
     bar.End();

@@ -4,11 +4,17 @@
 #include "FRep/Evaluators.h"
 #include "FRep/Hypervolume.h"
 #include "FRep/Sampling.h"
+#include "FRep/SinCos.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <iostream>
+#include <limits>
+
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <random>
 
 using namespace ictk::frep;
@@ -236,6 +242,208 @@ TEST(Evaluators, GradientOfSphereGivesOutwardNormal)
   EXPECT_NEAR(n[0], 0.6, 1e-15);
   EXPECT_NEAR(n[1], 0.0, 1e-15);
   EXPECT_NEAR(n[2], 0.8, 1e-15);
+}
+
+// Every interval evaluator, as one function from a tape and a region to the enclosure and the
+// choices it made, so that each runs the same tests against the point evaluator.
+struct IntervalEvaluatorUnderTest
+{
+  const char* name;
+  std::function<std::function<Interval(const Region&, std::vector<Choice>&)>(TapePtr)> make;
+};
+
+std::vector<IntervalEvaluatorUnderTest> intervalEvaluators()
+{
+  return {
+    { "IntervalEvaluator",
+      [](TapePtr tape)
+      {
+        auto e = std::make_shared<IntervalEvaluator>(tape);
+        return [e](const Region& r, std::vector<Choice>& choices)
+        {
+          const Interval v = e->eval(r);
+          choices = e->choices();
+          return v;
+        };
+      } },
+    { "IncrementalIntervalEvaluator",
+      [](TapePtr tape)
+      {
+        auto e = std::make_shared<IncrementalIntervalEvaluator>(tape);
+        return [e](const Region& r, std::vector<Choice>& choices)
+        {
+          const Interval v = e->eval(r);
+          choices = e->choices();
+          return v;
+        };
+      } },
+  };
+}
+
+// Random trees (every opcode) over random regions, small and large, that differ from the last
+// in a random subset of the axes (as the pieces of a ray do): every point sampled in a region
+// (its corners included) has a value, when finite, inside the evaluator's enclosure, and the
+// tape simplified by its choices gives the same value there bit for bit. Trees of sin and cos
+// over wide coordinates exercise their enclosures near extrema and far from the origin.
+TEST(Evaluators, EveryIntervalEvaluatorEnclosesPointValues)
+{
+  for (const IntervalEvaluatorUnderTest& under : intervalEvaluators())
+  {
+    Random rng(23);
+    std::size_t samples = 0;
+    for (int n = 0; n < TreeCount; ++n)
+    {
+      const bool trig = n % 3 == 0;
+      Expr e = randomTree(rng, 5, trig);
+      if (trig)
+      {
+        e = sin(e * rng.uniform(-40, 40)) * cos(Expr::x() * rng.uniform(-4000, 4000)) + e;
+      }
+      const TapePtr tape = Tape::compile(e);
+      auto eval = under.make(tape);
+      PointEvaluator point(tape);
+      Region region;
+      std::vector<Choice> choices;
+      for (int r = 0; r < 12; ++r)
+      {
+        const int mask = r == 0 ? 15 : 1 + rng.index(15);
+        for (int a = 0; a < 4; ++a)
+        {
+          if (mask & (1 << a))
+          {
+            const double c = rng.uniform(-3, 3), w = rng.uniform(0, r % 3 == 0 ? 2.0 : 0.05);
+            region.axes[a] = { c - w, c + w };
+          }
+        }
+        const Interval range = eval(region, choices);
+        PointEvaluator pruned(tape->simplify(choices));
+        for (int s = 0; s < 40; ++s)
+        {
+          std::array<double, 4> p;
+          for (int a = 0; a < 4; ++a)
+          {
+            p[a] = s == 0
+              ? region.axes[a].lo
+              : (s == 1 ? region.axes[a].hi : rng.uniform(region.axes[a].lo, region.axes[a].hi));
+          }
+          const double v = point.eval(p[0], p[1], p[2], p[3]);
+          if (std::isfinite(v))
+          {
+            ASSERT_LE(range.lo, v) << under.name << ": " << toString(e);
+            ASSERT_GE(range.hi, v) << under.name << ": " << toString(e);
+          }
+          else if (std::isnan(v))
+          {
+            ASSERT_TRUE(range.maybeNaN) << under.name << ": " << toString(e);
+          }
+          ASSERT_TRUE(sameDouble(v, pruned.eval(p[0], p[1], p[2], p[3])))
+            << under.name << ": " << toString(e);
+          ++samples;
+        }
+      }
+    }
+    EXPECT_EQ(samples, std::size_t(TreeCount) * 12 * 40) << under.name;
+  }
+}
+
+// The fast paths of the interval operations (plain operands: finite, ordered, no NaN) give what
+// the general code gives, bounds, NaN flag and choice bit for bit, for every opcode over operands
+// of every kind: plain, touching or straddling zero (of either sign), empty, possibly NaN,
+// infinite.
+TEST(Evaluators, FastIntervalOperationsMatchTheReferenceBitForBit)
+{
+  Random rng(31);
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  auto operand = [&]() -> Interval
+  {
+    switch (rng.index(10))
+    {
+      case 0:
+        return { 0.0, rng.uniform(0, 3), false };
+      case 1:
+        return { -rng.uniform(0, 3), -0.0, false };
+      case 2:
+        return { inf, -inf, true }; // NaN everywhere
+      case 3:
+        return { -rng.uniform(0, 3), rng.uniform(0, 3), true };
+      case 4:
+        return { -inf, rng.uniform(-3, 3), false };
+      case 5:
+      {
+        const double v = std::round(rng.uniform(-4, 4));
+        return { v, v, false };
+      }
+      case 6:
+      {
+        const double c = rng.uniform(-1e6, 1e6), w = rng.uniform(0, 10);
+        return { c - w, c + w, false };
+      }
+      default:
+      {
+        const double c = rng.uniform(-8, 8), w = rng.uniform(0, rng.index(2) ? 0.01 : 4.0);
+        return { c - w, c + w, false };
+      }
+    }
+  };
+  int plainCases = 0;
+  for (int n = 0; n < 200000; ++n)
+  {
+    const auto op = static_cast<Opcode>(
+      static_cast<int>(Opcode::Neg) + rng.index(static_cast<int>(Opcode::Count_) - 3));
+    const Interval a = operand(), b = operand(), c = operand();
+    Choice fast = Choice::Both, reference = Choice::Both;
+    const Interval x = detail::intervalOperation(op, a, b, c, fast);
+    const Interval y = detail::intervalOperationReference(op, a, b, c, reference);
+    ASSERT_TRUE(sameDouble(x.lo, y.lo) && sameDouble(x.hi, y.hi) && x.maybeNaN == y.maybeNaN &&
+      fast == reference)
+      << opcodeName(op) << " [" << a.lo << ", " << a.hi << ", " << a.maybeNaN << "] [" << b.lo
+      << ", " << b.hi << ", " << b.maybeNaN << "]: " << x.lo << " " << x.hi << " vs " << y.lo << " "
+      << y.hi;
+    plainCases += !a.maybeNaN && std::isfinite(a.lo) && std::isfinite(a.hi) ? 1 : 0;
+  }
+  EXPECT_GT(plainCases, 100000);
+}
+
+// SinCos.h's bound, against long double: random arguments over its whole range, arguments next to
+// multiples of pi/4 (where the reduction cancels most and the quadrant changes), and small ones.
+// The error stays below SinCosError, and libm's value (the point evaluators') within
+// SinCosWidening.
+TEST(Evaluators, SinCosWithoutLibmKeepsItsErrorBound)
+{
+  Random rng(41);
+  long double worst = 0;
+  auto check = [&](double x)
+  {
+    const long double s = std::sin(static_cast<long double>(x));
+    const long double c = std::cos(static_cast<long double>(x));
+    const double as = detail::sinApprox(x), ac = detail::cosApprox(x);
+    worst = std::max({ worst, std::fabs(as - s), std::fabs(ac - c) });
+    ASSERT_LE(std::fabs(as - s), detail::SinCosError) << x;
+    ASSERT_LE(std::fabs(ac - c), detail::SinCosError) << x;
+    ASSERT_LE(std::fabs(as - std::sin(x)), detail::SinCosWidening) << x;
+    ASSERT_LE(std::fabs(ac - std::cos(x)), detail::SinCosWidening) << x;
+  };
+  for (int n = 0; n < 1000000; ++n)
+  {
+    const double magnitude = std::ldexp(1.0, rng.index(21)); // 1 .. 2^20
+    check(rng.uniform(-magnitude, magnitude));
+    const double k = std::round(rng.uniform(-magnitude, magnitude) * 4 / 3.14159265358979);
+    const double near = k * (3.14159265358979323846 / 4);
+    if (std::abs(near) <= detail::SinCosLimit)
+    {
+      check(near);
+      check(std::nextafter(near, 0.0));
+      check(near + rng.uniform(-1e-9, 1e-9));
+    }
+    check(rng.uniform(-1e-6, 1e-6));
+  }
+  check(0.0);
+  check(-0.0);
+  check(detail::SinCosLimit);
+  check(-detail::SinCosLimit);
+  // The bound is not loose by orders of magnitude: the worst case seen is within 8x of it.
+  EXPECT_GT(worst, detail::SinCosError / 8) << static_cast<double>(worst);
+  std::cout << "largest error of sinApprox/cosApprox seen: " << static_cast<double>(worst) << "\n";
 }
 
 TEST(Evaluators, IntervalsEnclosePointSamplesAndPruningKeepsValues)

@@ -369,7 +369,91 @@ def check_mesh(ictk, work, data):
     compare_modes(ictk, work, "flower", os.path.join(data, "Models/flower/flower.json"), 160, 120,
                   "-70,25")
     compare_modes(ictk, work, "walnut", "walnut", 160, 120, "30,20")
+    check_tetmesh_mesh_mode(ictk, work)
     print("all checks passed")
+
+
+def orthographic_camera(path, position, focal, up):
+    import json
+    with open(path, "w") as f:
+        json.dump({"position": position, "focal_point": focal, "up": up,
+                   "projection": "orthographic", "parallel_scale": 1}, f)
+    return path
+
+
+def check_tetmesh_mesh_mode(ictk, work):
+    """A .vtu tetrahedral mesh through VTK's polygon pipeline (--mode mesh), against pictures
+    worked out by hand, the ray caster's rasteriser, and bad input. The two cubes of
+    write_two_cubes in 40 x 40 pixels of 0.05 (orthographic, parallel scale 1): seen from +z, the
+    whole mesh's silhouette is the 2 x 1 rectangle, exactly the 40 x 20 pixels whose centres lie in
+    it (half the picture); cut by x = 1 and seen from +x, the cut face is the 20 x 20 pixels of the
+    unit square in the grey map's colour of material 1 (0.15: 38 of 255), or, from -x with the
+    other half kept, of material 2 (255). Without --colour-by a mesh is coloured by its MaterialId:
+    the same picture as with it. Then the cubes both ways in perspective (compare_modes)."""
+    mesh = os.path.join(work, "cubes.vtu")
+    write_two_cubes(mesh)
+    top = orthographic_camera(os.path.join(work, "top.json"), [1, 0.5, 5], [1, 0.5, 0], [0, 1, 0])
+    plus_x = orthographic_camera(os.path.join(work, "plus-x.json"), [5, 0.5, 0.5],
+                                 [0, 0.5, 0.5], [0, 0, 1])
+    minus_x = orthographic_camera(os.path.join(work, "minus-x.json"), [-5, 0.5, 0.5],
+                                  [0, 0.5, 0.5], [0, 0, 1])
+    cases = [("top", top, [], 12, 800, lambda row, col: 10 <= row < 30, None),
+             ("cut", plus_x, ["--cut", "1,0,0,1"], 6, 400,
+              lambda row, col: 10 <= row < 30 and 10 <= col < 30, round(255 * 0.15)),
+             ("cut-other-side", minus_x, ["--cut", "-1,0,0,-1"], 6, 400,
+              lambda row, col: 10 <= row < 30 and 10 <= col < 30, 255)]
+    for name, camera, args, kept, covered, inside, grey in cases:
+        pictures = {}
+        for mode, colour_by in (("mesh", []), ("mesh", ["--colour-by", "MaterialId"]),
+                                ("raycast", [])):
+            png = os.path.join(work, f"tets-{name}-{mode}{'-by' if colour_by else ''}.png")
+            p = run(ictk, ["render", mesh, "-o", png, "--size", "40,40", "--camera", camera,
+                           "--mode", mode, "--colour-map", "grey", "--range", "1,2"]
+                    + colour_by + args)
+            expected = f"{kept} of 12 tetrahedra kept, {covered} pixels covered, colour map over"
+            if expected not in p.stdout:
+                sys.exit(f"FAIL: tets {name} {mode}: expected '{expected}' in:\n{p.stdout}")
+            w, h, pixels = read_png(png)
+            pictures[png] = pixels
+            for row in range(h):
+                for col in range(w):
+                    r, g, b, a = pixels[row * w + col]
+                    if inside(row, col) != (a == 255):
+                        sys.exit(f"FAIL: tets {name} {mode}: pixel {col},{row} alpha {a}")
+                    if grey is not None and a == 255 and abs(r - grey) > 1:
+                        sys.exit(f"FAIL: tets {name} {mode}: pixel {col},{row} is {r}, "
+                                 f"expected {grey}")
+        default, by, ray = pictures.values()
+        if default != by:
+            sys.exit(f"FAIL: tets {name}: without --colour-by the mesh is not coloured by "
+                     "MaterialId")
+        if grey is not None and by != ray:
+            sys.exit(f"FAIL: tets {name}: the face-on cut differs between the modes")
+    print("tets: silhouettes and cut faces as worked out by hand in both modes")
+    compare_modes(ictk, work, "tets", mesh, 160, 120, "30,20")
+    # Bad input: one line naming the file, exit 2, no picture.
+    import vtk
+    empty = os.path.join(work, "empty.vtu")
+    grid = vtk.vtkUnstructuredGrid()
+    points = vtk.vtkPoints()
+    points.InsertNextPoint(0, 0, 0)
+    grid.SetPoints(points)
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(empty)
+    w.SetInputData(grid)
+    w.Write()
+    garbage = os.path.join(work, "garbage.vtu")
+    with open(garbage, "w") as f:
+        f.write("not XML\n")
+    for path, message in ((empty, f"'{empty}' has no cells"),
+                          (garbage, f"cannot read '{garbage}' as a VTK unstructured grid"),
+                          (os.path.join(work, "nope.vtu"), "cannot read '")):
+        out = os.path.join(work, "bad.png")
+        q = subprocess.run([ictk, "render", path, "--mode", "mesh", "-o", out],
+                           capture_output=True, text=True)
+        lines = q.stderr.strip().splitlines()
+        if q.returncode != 2 or len(lines) != 1 or message not in lines[0] or os.path.exists(out):
+            sys.exit(f"FAIL: --mode mesh {path}: exit {q.returncode}, stderr:\n{q.stderr}")
 
 
 def write_two_cubes(path):

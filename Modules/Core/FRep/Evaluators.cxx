@@ -2,6 +2,7 @@
 #include "FRep/Evaluators.h"
 
 #include "FRep/Kernels.h"
+#include "FRep/SinCos.h"
 #include "FRep/TapeDetail.h"
 
 #include <algorithm>
@@ -490,6 +491,16 @@ Interval trigRange(bool isSin, const Interval& a)
   const bool hasMin = minAt + 2 * pi * std::ceil((a.lo - minAt) / (2 * pi)) <= a.hi;
   if (hasMax && hasMin)
     return { -1.0, 1.0, a.maybeNaN }; // what widening and clamping give below, without libm
+  if (std::abs(a.lo) <= detail::SinCosLimit && std::abs(a.hi) <= detail::SinCosLimit)
+  {
+    // The ends without libm (SinCos.h), widened by their proven error bound and by an ulp for
+    // the widening's own rounding.
+    const double fLo = isSin ? detail::sinApprox(a.lo) : detail::cosApprox(a.lo);
+    const double fHi = isSin ? detail::sinApprox(a.hi) : detail::cosApprox(a.hi);
+    const double lo = hasMin ? -1.0 : nextDown(std::min(fLo, fHi) - detail::SinCosWidening);
+    const double hi = hasMax ? 1.0 : nextUp(std::max(fLo, fHi) + detail::SinCosWidening);
+    return { std::max(lo, -1.0), std::min(hi, 1.0), a.maybeNaN };
+  }
   const double fLo = isSin ? std::sin(a.lo) : std::cos(a.lo);
   const double fHi = isSin ? std::sin(a.hi) : std::cos(a.hi);
   const double lo = hasMin ? -1.0 : std::min(fLo, fHi);
@@ -685,7 +696,130 @@ Interval intervalOp(
       return { -inf, inf, true };
   }
 }
+
+// Bounds that are finite and ordered, with no NaN: what nearly every instruction of a model sees
+// over a box inside its domain.
+inline bool plain(const Interval& a)
+{
+  return !a.maybeNaN && a.lo >= -std::numeric_limits<double>::max() &&
+    a.hi <= std::numeric_limits<double>::max() && a.lo <= a.hi;
+}
+
+// intervalOp for the common opcodes on plain operands, without the checks that only NaN, empty
+// or infinite operands need (the same bounds, flags and choices bit for bit: intervalOp's
+// branches for such operands reduce to these lines), and inlined into the evaluation loops, so
+// that an instruction costs its arithmetic and its outward rounding rather than two dispatches
+// and a call. Every other case goes to intervalOp.
+inline Interval fastIntervalOp(
+  Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice)
+{
+  switch (op)
+  {
+    case Opcode::Add:
+      if (plain(a) && plain(b))
+      {
+        choice = Choice::Both;
+        const Interval r{ nextDown(a.lo + b.lo), nextUp(a.hi + b.hi), false };
+        return a.lo >= 0 && b.lo >= 0 ? nonNegative(r) : r;
+      }
+      break;
+    case Opcode::Sub:
+      if (plain(a) && plain(b))
+      {
+        choice = Choice::Both;
+        return { nextDown(a.lo - b.hi), nextUp(a.hi - b.lo), false };
+      }
+      break;
+    case Opcode::Mul:
+      if (plain(a) && plain(b))
+      {
+        choice = Choice::Both;
+        // Finite products: no NaN, no zero times infinity.
+        const double p0 = a.lo * b.lo, p1 = a.lo * b.hi, p2 = a.hi * b.lo, p3 = a.hi * b.hi;
+        const Interval r{ nextDown(std::min(std::min(p0, p1), std::min(p2, p3))),
+          nextUp(std::max(std::max(p0, p1), std::max(p2, p3))), false };
+        const bool sameSign = (a.lo >= 0 && b.lo >= 0) || (a.hi <= 0 && b.hi <= 0);
+        return sameSign ? nonNegative(r) : r;
+      }
+      break;
+    case Opcode::Min:
+    case Opcode::Max:
+      if (plain(a) && plain(b))
+      {
+        const bool isMin = op == Opcode::Min;
+        if (isMin ? a.hi <= b.lo : a.lo >= b.hi)
+        {
+          choice = Choice::First;
+          return a;
+        }
+        if (isMin ? b.hi < a.lo : b.lo > a.hi)
+        {
+          choice = Choice::Second;
+          return b;
+        }
+        choice = Choice::Both;
+        return isMin ? Interval{ std::min(a.lo, b.lo), std::min(a.hi, b.hi), false }
+                     : Interval{ std::max(a.lo, b.lo), std::max(a.hi, b.hi), false };
+      }
+      break;
+    case Opcode::Neg:
+      if (plain(a))
+      {
+        choice = Choice::Both;
+        return { -a.hi, -a.lo, false };
+      }
+      break;
+    case Opcode::Square:
+      if (plain(a))
+      {
+        choice = Choice::Both;
+        return squareRange(a);
+      }
+      break;
+    case Opcode::Abs:
+      if (plain(a))
+      {
+        choice = Choice::Both;
+        if (a.lo >= 0)
+          return a;
+        if (a.hi <= 0)
+          return { -a.hi, -a.lo, false };
+        return { 0.0, std::max(-a.lo, a.hi), false };
+      }
+      break;
+    case Opcode::Sqrt:
+      if (plain(a) && a.hi >= 0)
+      {
+        choice = Choice::Both;
+        return nonNegative(widen({ std::sqrt(std::max(a.lo, 0.0)), std::sqrt(a.hi), a.lo < 0 }));
+      }
+      break;
+    case Opcode::Sin:
+    case Opcode::Cos:
+      if (plain(a))
+      {
+        choice = Choice::Both;
+        return trigRange(op == Opcode::Sin, a);
+      }
+      break;
+    default:
+      break;
+  }
+  return intervalOp(op, a, b, c, choice);
+}
 } // namespace
+
+Interval detail::intervalOperation(
+  Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice)
+{
+  return fastIntervalOp(op, a, b, c, choice);
+}
+
+Interval detail::intervalOperationReference(
+  Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice)
+{
+  return intervalOp(op, a, b, c, choice);
+}
 
 IntervalEvaluator::IntervalEvaluator(TapePtr tape, const std::vector<double>& parameters)
   : tape_(std::move(tape))
@@ -720,7 +854,8 @@ Interval IntervalEvaluator::eval(const Region& region)
   for (std::size_t i = 0; i < code.size(); ++i)
   {
     const Instruction& ins = code[i];
-    slots_[ins.out] = intervalOp(ins.op, slots_[ins.a], slots_[ins.b], slots_[ins.c], choices_[i]);
+    slots_[ins.out] =
+      fastIntervalOp(ins.op, slots_[ins.a], slots_[ins.b], slots_[ins.c], choices_[i]);
   }
   return slots_[tape_->outputs()[0]];
 }
@@ -819,7 +954,7 @@ Interval IncrementalIntervalEvaluator::eval(const Region& region)
     {
       const Instruction& ins = code[i];
       values_[ins.out] =
-        intervalOp(ins.op, values_[ins.a], values_[ins.b], values_[ins.c], choices_[i]);
+        fastIntervalOp(ins.op, values_[ins.a], values_[ins.b], values_[ins.c], choices_[i]);
     }
   }
   return values_[ssa_.output];

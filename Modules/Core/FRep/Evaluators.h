@@ -174,6 +174,18 @@ private:
   std::vector<ValueGradient> slots_;
 };
 
+namespace detail
+{
+/// The interval counterpart of one opcode, as the interval evaluators apply it: an enclosure of
+/// the point values over operands in a, b, c, and the choice a min, max or select can make.
+Interval intervalOperation(
+  Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice);
+/// The same without the fast paths for plain operands (finite, ordered, no NaN): the reference
+/// the fast paths must match bit for bit (Testing/Core/TestEvaluators.cxx).
+Interval intervalOperationReference(
+  Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice);
+} // namespace detail
+
 /// Outward unit normal n = -grad f / |grad f| (thesis L608-L610); zero where the gradient vanishes.
 std::array<double, 3> outwardNormal(const ValueGradient& g);
 

@@ -44,11 +44,20 @@ class TapeStage final : public detail::Stage
 {
 public:
   TapeStage(TapePtr tape, const std::vector<double>& parameters, double time)
-    : tape_(std::move(tape))
-    , parameters_(parameters)
-    , time_(time)
-    , interval_(tape_, parameters_)
+    : TapeStage(std::move(tape), parameters, time, std::make_shared<Kept>())
   {
+  }
+
+  ~TapeStage() override { kept_->instructions -= tape_->instructions().size(); }
+
+  /// Drops the kept narrowings, when the thread keeps more than its budget.
+  void forget() override
+  {
+    if (kept_->instructions > KeptInstructionBudget)
+    {
+      narrowed_.clear();
+      uncached_.reset();
+    }
   }
 
   Interval bound(const Box3& box) override
@@ -63,8 +72,10 @@ public:
   }
 
   /// The tape simplified by the choices of the interval evaluator's last eval, or null when
-  /// nothing would be cut.
-  std::unique_ptr<detail::Stage> narrowed() override
+  /// nothing would be cut. Neighbouring nodes mostly make the same choices, so the stages of the
+  /// last few sets of choices are kept and given again: building a tape and its evaluators cost
+  /// more than the evaluations of most nodes.
+  detail::Stage* narrowed() override
   {
     if (tape_->choiceCount() == 0)
     {
@@ -76,12 +87,32 @@ public:
     {
       return nullptr;
     }
+    for (Narrowed& n : narrowed_)
+    {
+      if (n.choices == choices)
+      {
+        return n.stage.get();
+      }
+    }
     TapePtr pruned = interval_.simplified();
     if (pruned == tape_)
     {
       return nullptr;
     }
-    return std::make_unique<TapeStage>(std::move(pruned), parameters_, time_);
+    auto stage =
+      std::unique_ptr<TapeStage>(new TapeStage(std::move(pruned), parameters_, time_, kept_));
+    if (kept_->instructions > KeptInstructionBudget)
+    {
+      // Over the thread's budget: this one is not kept (castTile drops the kept ones).
+      uncached_ = std::move(stage);
+      return uncached_.get();
+    }
+    if (narrowed_.size() == KeptNarrowings)
+    {
+      narrowed_.erase(narrowed_.begin()); // the oldest
+    }
+    narrowed_.push_back({ choices, std::move(stage) });
+    return narrowed_.back().stage.get();
   }
 
   double value(const Point3& p) override
@@ -104,6 +135,26 @@ public:
   }
 
 private:
+  /// What a thread's stages keep: the instructions of all its live stages' tapes.
+  struct Kept
+  {
+    std::size_t instructions = 0;
+  };
+  /// About 10 MB of tapes and evaluator values per thread (prospero at 512^2, 2 threads: 13 MB more
+  /// peak memory than without).
+  static constexpr std::size_t KeptInstructionBudget = std::size_t(1) << 16;
+
+  TapeStage(
+    TapePtr tape, const std::vector<double>& parameters, double time, std::shared_ptr<Kept> kept)
+    : tape_(std::move(tape))
+    , parameters_(parameters)
+    , time_(time)
+    , interval_(tape_, parameters_)
+    , kept_(std::move(kept))
+  {
+    kept_->instructions += tape_->instructions().size();
+  }
+
   TapePtr tape_;
   const std::vector<double>& parameters_;
   double time_;
@@ -114,6 +165,15 @@ private:
   frep::IncrementalIntervalEvaluator interval_;
   std::optional<frep::IncrementalPointEvaluator> point_;
   std::optional<frep::GradientEvaluator> gradient_;
+  static constexpr std::size_t KeptNarrowings = 4;
+  struct Narrowed
+  {
+    std::vector<frep::Choice> choices;
+    std::unique_ptr<TapeStage> stage;
+  };
+  std::vector<Narrowed> narrowed_;
+  std::shared_ptr<Kept> kept_;
+  std::unique_ptr<TapeStage> uncached_; // the last narrowing, when over the budget
 };
 
 /// A field's evaluator as a stage.
@@ -129,10 +189,11 @@ public:
     last_ = box;
     return evaluator_->bound(box);
   }
-  std::unique_ptr<detail::Stage> narrowed() override
+  detail::Stage* narrowed() override
   {
     std::unique_ptr<frep::FieldEvaluator> n = evaluator_->narrowed(last_);
-    return n ? std::make_unique<FieldStage>(std::move(n)) : nullptr;
+    narrowed_ = n ? std::make_unique<FieldStage>(std::move(n)) : nullptr;
+    return narrowed_.get();
   }
   double value(const Point3& p) override { return evaluator_->value(p); }
   Point3 gradient(const Point3& p) override
@@ -145,6 +206,7 @@ public:
 private:
   std::unique_ptr<frep::FieldEvaluator> evaluator_;
   Box3 last_{};
+  std::unique_ptr<FieldStage> narrowed_;
 };
 
 /// A model's attribute at the first point found inside: a colour (3 or 4 components in [0, 1],
@@ -220,6 +282,10 @@ struct Workspace
   std::unique_ptr<detail::Painter> painter;
   std::vector<std::uint8_t> done; // the current tile's pixels that found their surface
   std::size_t doneCount = 0;      // how many
+  /// The same per row of a tile at most 64 pixels wide, bit i for column tile.i0 + i: a node's
+  /// pixels still to be found are then a few masks, not a scan of its pixels (1 % of
+  /// render-sphere-gyroid's instructions).
+  std::vector<std::uint64_t> doneRows;
   /// Per pixel of the tile: the depth of the first piece that was left unresolved (NaN: none).
   std::vector<double> unresolvedAt;
   Rect tile{ 0, 0, 0, 0 };
@@ -322,11 +388,14 @@ private:
     const std::size_t pixels = static_cast<std::size_t>(tile.i1 - tile.i0) * (tile.j1 - tile.j0);
     ws.done.assign(pixels, 0);
     ws.doneCount = 0;
+    ws.doneRows.assign(
+      tile.i1 - tile.i0 <= 64 ? static_cast<std::size_t>(tile.j1 - tile.j0) : 0, 0);
     ws.unresolvedAt.assign(pixels, std::numeric_limits<double>::quiet_NaN());
     if (!(far_ > near_))
     {
       return; // the box is behind the camera
     }
+    ws.root->forget(); // nothing below the root is in use between tiles
     node(ws, *ws.root, tile, near_, far_);
     // Rays that left a piece unresolved and found nothing behind it within a leaf.
     for (int j = tile.j0; j < tile.j1; ++j)
@@ -383,6 +452,29 @@ private:
       return true; // nothing found yet in this tile: every pixel remains
     }
     Rect p{ r.i1, r.j1, r.i0, r.j0 };
+    if (!limited_ && !ws.doneRows.empty())
+    {
+      const int first = r.i0 - ws.tile.i0, width = r.i1 - r.i0;
+      const std::uint64_t columns =
+        (width == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << width) - 1) << first;
+      for (int j = r.j0; j < r.j1; ++j)
+      {
+        const std::uint64_t open = ~ws.doneRows[static_cast<std::size_t>(j - ws.tile.j0)] & columns;
+        if (open)
+        {
+          p.j0 = std::min(p.j0, j);
+          p.j1 = j + 1;
+          p.i0 = std::min(p.i0, ws.tile.i0 + __builtin_ctzll(open));
+          p.i1 = std::max(p.i1, ws.tile.i0 + 64 - __builtin_clzll(open));
+        }
+      }
+      if (p.i0 >= p.i1)
+      {
+        return false;
+      }
+      r = p;
+      return true;
+    }
     for (int j = r.j0; j < r.j1; ++j)
     {
       for (int i = r.i0; i < r.i1; ++i)
@@ -430,13 +522,20 @@ private:
     Point3 lo, hi;
     lo.fill(std::numeric_limits<double>::infinity());
     hi.fill(-std::numeric_limits<double>::infinity());
-    for (int k = 0; k < 8; ++k)
+    // Camera::point(u, v, s) at the 8 corners, each ray's origin and direction made once: the
+    // same arithmetic, so the same points bit for bit.
+    for (int k = 0; k < 4; ++k)
     {
-      const Point3 p = camera_.point(u[k & 1], v[(k >> 1) & 1], (k & 4) ? s1 : s0);
-      for (int a = 0; a < 3; ++a)
+      const Point3 o = camera_.origin(u[k & 1], v[k >> 1]);
+      const Point3 d = camera_.direction(u[k & 1], v[k >> 1]);
+      for (const double s : { s0, s1 })
       {
-        lo[a] = std::min(lo[a], p[a]);
-        hi[a] = std::max(hi[a], p[a]);
+        const Point3 p = frep::add(o, frep::scale(d, s));
+        for (int a = 0; a < 3; ++a)
+        {
+          lo[a] = std::min(lo[a], p[a]);
+          hi[a] = std::max(hi[a], p[a]);
+        }
       }
     }
     return mayHold(ws, stage, lo, hi);
@@ -477,11 +576,10 @@ private:
     {
       return;
     }
-    // A node whose children are single pixels keeps its tape: a tape simplified for it would
-    // serve a few evaluations of at most four rays, and building it costs more than they save
-    // (7% of the instructions of render-sphere-gyroid).
-    const bool pixelsNext = r.i1 - r.i0 <= 2 && r.j1 - r.j0 <= 2;
-    std::unique_ptr<detail::Stage> narrow = pixelsNext ? nullptr : stage.narrowed();
+    // Every node simplifies its tape, those whose children are single pixels too: with the
+    // narrowings kept (TapeStage::narrowed), a simplified tape is mostly found rather than built
+    // (building one for a few evaluations of at most four rays cost more than they saved).
+    detail::Stage* narrow = stage.narrowed();
     detail::Stage& next = narrow ? *narrow : stage;
     const int across = std::max(r.i1 - r.i0, r.j1 - r.j0);
     if (s1 - s0 > across * footprint(s1))
@@ -577,8 +675,9 @@ private:
     {
       return false;
     }
-    // The tape is not simplified again along one pixel's ray: building a tape there costs more
-    // than the instructions it removes (9% of the time of render-sphere-gyroid-1024).
+    // The tape is not simplified again along one pixel's ray: building a tape there cost more
+    // than the instructions it removes (9% of the time of render-sphere-gyroid-1024), and with
+    // the narrowings kept (TapeStage::narrowed) it saves nothing measurable either.
     if (divisible && (b - a) * ray.length > leafLength)
     {
       return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
@@ -678,6 +777,11 @@ private:
     std::uint8_t& d = done(ws, ray.i, ray.j);
     ws.doneCount += d ? 0 : 1;
     d = 1;
+    if (!ws.doneRows.empty())
+    {
+      ws.doneRows[static_cast<std::size_t>(ray.j - ws.tile.j0)] |= std::uint64_t(1)
+        << (ray.i - ws.tile.i0);
+    }
     const Paint paint = ws.painter && !unresolved ? ws.painter->at(ray.at(inside)) : Paint{};
     // A solid cut by its box shows the cut flat, lit by the face's normal (its gradient there
     // belongs to no surface: on a tie of a min or max it even flips from pixel to pixel).

@@ -28,8 +28,12 @@ public:
   /// An enclosure of f over the box.
   virtual frep::Interval bound(const frep::Box3& box) = 0;
   /// A stage with a shorter evaluation that gives the same values in the box of the last
-  /// bound(); null when nothing would be cut.
-  virtual std::unique_ptr<Stage> narrowed() = 0;
+  /// bound(); null when nothing would be cut. This stage owns it, and it stays valid until this
+  /// stage's next narrowed() (the quadtree asks a stage again only for a sibling node, when the
+  /// stage it got for the last one is no longer in use).
+  virtual Stage* narrowed() = 0;
+  /// May drop the stages narrowed() keeps for reuse (called when none of them is in use).
+  virtual void forget() {}
   virtual double value(const frep::Point3& p) = 0;
   virtual frep::Point3 gradient(const frep::Point3& p) = 0;
 };
