@@ -799,6 +799,47 @@ TEST(EngineSkeleton, TheWeightMapCollapsesTheTopFirst)
   EXPECT_EQ(inversions, 0);
 }
 
+// T-5.5 item 6 in the complex: a skinned cell's normals go with its points as "Normals", and a
+// non-uniform placement, scale(2, 1, 1), maps them by its inverse transpose diag(1/2, 1, 1)
+// (normalised), not by the scale itself. At t = 1 the upper joint has turned an eighth about z:
+// the normals there are no longer along the axes, where the two would agree.
+TEST(EngineSkeleton, TheComplexCarriesTheNormalsByTheInverseTranspose)
+{
+  if (!skin::canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  engine::DynamicModel m = engine::DynamicModel::load(Write("normals.icm",
+    "CELLS { A { type = B-CELL; shape = loadMesh(\"" + Tube() +
+      "\", \"walk\"); dim = 2D; parameters { scale(2, 1, 1); } } }\nK { CELLS { A; } }\n")
+                                                        .string());
+  m.advanceTo(1.0, 0.5);
+  const auto cells = m.cells();
+  const auto& part = CellOf(cells, "A").shape->parts[0];
+  const ictk::complex::Complex cx = m.complex();
+  const auto& g = std::get<ictk::complex::ExplicitGeometry>(cx.cell(0).geometry);
+  auto normalsOf = [](const std::vector<ictk::discretize::PointArray>& arrays)
+  {
+    for (const auto& a : arrays)
+      if (a.name == "Normals")
+        return a.values;
+    return std::vector<double>{};
+  };
+  const std::vector<double> local = normalsOf(part.pointData), world = normalsOf(g.pointData);
+  ASSERT_EQ(local.size(), 3 * part.points.size());
+  ASSERT_EQ(world.size(), local.size());
+  double apartFromTheScale = 0;
+  for (std::size_t i = 0; i < local.size(); i += 3)
+  {
+    const Vec3 n{ 0.5 * local[i], local[i + 1], local[i + 2] };
+    const double k = std::sqrt(ictk::frep::dot(n, n));
+    for (std::size_t c = 0; c < 3; ++c)
+      EXPECT_NEAR(world[i + c], n[c] / k, 1e-15) << "vertex " << i / 3;
+    const Vec3 byScale{ 2 * local[i], local[i + 1], local[i + 2] };
+    const double s = std::sqrt(ictk::frep::dot(byScale, byScale));
+    apartFromTheScale = std::max(apartFromTheScale, std::abs(world[i] - byScale[0] / s));
+  }
+  EXPECT_GT(apartFromTheScale, 0.1);
+}
+
 // What cannot work is refused at its place: a weight map that names no function or a function
 // of the wrong arity or is not quoted, a spread outside [0, 1), a mesh cell with no stand-in, a
 // projection built-in on a cell that is not a mesh.
