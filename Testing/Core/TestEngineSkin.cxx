@@ -639,6 +639,10 @@ TEST(EngineSkeleton, TheMetamorphosisGoesFromTheSourceMeshToTheDestinationMesh)
   m.advanceTo(0.5, 0.25);
   EXPECT_EQ(m.activeInstance(), "K1");
   ExpectMesh(m, "Source", x.sourcePlace, plain(x.source, 0.5), "t 0.5");
+  // K2 begins at t = 1 with alpha = 0: the plain skinned source still (T-5.5 item 1).
+  m.advanceTo(1.0, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K2");
+  ExpectMesh(m, "Source", x.sourcePlace, plain(x.source, 1.0), "t 1");
   // K2 at 1.25 (alpha = 1/2): the library's pose, the top of the cylinder further on its way.
   m.advanceTo(1.25, 0.25);
   EXPECT_EQ(m.activeInstance(), "K2");
@@ -717,6 +721,10 @@ TEST(EngineSkeleton, TheMetamorphosisGoesFromTheSourceMeshToTheDestinationMesh)
     on.posed, *Metamorphosis::posedField(x.target, x.targetStandIn, 4.0), x.targetPlace);
   EXPECT_LT(r.distance, 1e-9);
   EXPECT_LT(r.degrees, 1e-6);
+  // K4 from t = 4.5, alpha = 0 with every delay: the plain destination already.
+  m.advanceTo(4.75, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K4");
+  ExpectMesh(m, "Target", x.targetPlace, plain(x.target, 4.75), "t 4.75");
   // K5: the plain destination, points and normals (T-5.5 item 4: 1e-9).
   m.advanceTo(5.5, 0.25);
   EXPECT_EQ(m.activeInstance(), "K5");
