@@ -3,6 +3,9 @@
 
 #include "FRep/Tape.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -60,6 +63,21 @@ PointProjection projectPoint(
   return r;
 }
 
+/// Runs `work(evaluator, i)` for every i < count on TBB's threads, one evaluator of `field` per
+/// block of vertices: every vertex writes its own slots, so the results do not depend on the
+/// threads.
+template <class Work>
+void forEachVertex(std::size_t count, const frep::Field& field, Work&& work)
+{
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64),
+    [&](const tbb::blocked_range<std::size_t>& range)
+    {
+      const auto evaluator = field.evaluator();
+      for (std::size_t i = range.begin(); i != range.end(); ++i)
+        work(*evaluator, i);
+    });
+}
+
 Vec3 unit(const Vec3& v)
 {
   const double n = frep::norm(v);
@@ -101,13 +119,16 @@ Projection projectOntoStandIn(
 {
   const auto field =
     frep::tapeField(frep::Tape::compile(standInShape(standIn).function()), 0.0, {});
-  const auto evaluator = field->evaluator();
+  std::vector<PointProjection> found(mesh.vertexCount());
+  forEachVertex(mesh.vertexCount(), *field,
+    [&](frep::FieldEvaluator& evaluator, std::size_t i)
+    { found[i] = projectPoint(evaluator, mesh.restPoints[i], options); });
   Projection out;
   out.offsets.resize(mesh.vertexCount());
   out.standInNormals.resize(mesh.vertexCount());
   for (std::size_t i = 0; i < mesh.vertexCount(); ++i)
   {
-    const PointProjection r = projectPoint(*evaluator, mesh.restPoints[i], options);
+    const PointProjection& r = found[i];
     out.offsets[i] = frep::sub(r.point, mesh.restPoints[i]);
     out.standInNormals[i] = outward(r.gradient);
     out.iterations = std::max(out.iterations, r.iterations);
@@ -229,21 +250,24 @@ ProjectedPose poseOnStandIn(const SkinnedMesh& mesh, const Projection& projectio
   // q0_i: the whole bind-pose projection skinned, the start of the posed remainder.
   const Posed whole =
     skin(mesh, jointMatrices, projectedRestPoints(mesh, projection, 1.0), std::vector<Vec3>{});
-  const auto evaluator = posedStandIn.evaluator();
+  std::vector<char> converged(n, 1);
+  forEachVertex(n, posedStandIn,
+    [&](frep::FieldEvaluator& evaluator, std::size_t i)
+    {
+      const double a = std::clamp(alphas[i], 0.0, 1.0);
+      if (!(a > 0))
+        return;
+      const PointProjection r = projectPoint(evaluator, whole.points[i], options);
+      converged[i] = r.converged;
+      const Vec3 remainder = frep::sub(r.point, whole.points[i]);
+      Vec3& p = out.posed.points[i];
+      // At a = 1 the point is the projection itself, not a sum that rounds next to it.
+      p = a == 1.0 ? r.point : frep::add(p, frep::scale(remainder, a));
+      out.posed.normals[i] = slerpDirection(out.posed.normals[i], outward(r.gradient), a);
+    });
   for (std::size_t i = 0; i < n; ++i)
-  {
-    const double a = std::clamp(alphas[i], 0.0, 1.0);
-    if (!(a > 0))
-      continue;
-    const PointProjection r = projectPoint(*evaluator, whole.points[i], options);
-    if (!r.converged && out.failures++ == 0)
+    if (!converged[i] && out.failures++ == 0)
       out.firstFailure = i;
-    const Vec3 remainder = frep::sub(r.point, whole.points[i]);
-    Vec3& p = out.posed.points[i];
-    // At a = 1 the point is the projection itself, not a sum that rounds next to it.
-    p = a == 1.0 ? r.point : frep::add(p, frep::scale(remainder, a));
-    out.posed.normals[i] = slerpDirection(out.posed.normals[i], outward(r.gradient), a);
-  }
   return out;
 }
 
@@ -251,27 +275,32 @@ ProjectionResidual projectionResidual(
   const Posed& posed, const frep::Field& posedStandIn, const Affine& place)
 {
   const Affine normalMap = inverseTransposeOf(place);
-  const auto evaluator = posedStandIn.evaluator();
-  ProjectionResidual out;
-  for (std::size_t i = 0; i < posed.points.size(); ++i)
-  {
-    Vec3 g{ 0, 0, 0 };
-    const double f = evaluator->gradient(posed.points[i], g);
-    const Vec3 gw = normalMap.applyLinear(g);
-    const double length = frep::norm(gw);
-    const double d = length > 0 && std::isfinite(f) ? std::abs(f) / length
-                                                    : std::numeric_limits<double>::infinity();
-    if (d > out.distance)
+  const std::size_t n = posed.points.size();
+  std::vector<double> distances(n, 0.0), degrees(n, 0.0);
+  forEachVertex(n, posedStandIn,
+    [&](frep::FieldEvaluator& evaluator, std::size_t i)
     {
-      out.distance = d;
+      Vec3 g{ 0, 0, 0 };
+      const double f = evaluator.gradient(posed.points[i], g);
+      const Vec3 gw = normalMap.applyLinear(g);
+      const double length = frep::norm(gw);
+      distances[i] = length > 0 && std::isfinite(f) ? std::abs(f) / length
+                                                    : std::numeric_limits<double>::infinity();
+      if (!posed.normals.empty())
+      {
+        const Vec3 normal = unit(normalMap.applyLinear(posed.normals[i]));
+        degrees[i] = length > 0 ? angleDegrees(normal, outward(gw)) : 180.0;
+      }
+    });
+  ProjectionResidual out;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (distances[i] > out.distance)
+    {
+      out.distance = distances[i];
       out.farthest = i;
     }
-    if (!posed.normals.empty())
-    {
-      const Vec3 normal = unit(normalMap.applyLinear(posed.normals[i]));
-      const double degrees = length > 0 ? angleDegrees(normal, outward(gw)) : 180.0;
-      out.degrees = std::max(out.degrees, degrees);
-    }
+    out.degrees = std::max(out.degrees, degrees[i]);
   }
   return out;
 }
