@@ -517,72 +517,184 @@ TEST(EngineSkeleton, TheCheckerAndTheEngineRefuseWhatCannotWork)
   EXPECT_NE(e.find("setDeformation takes a skinned cell"), std::string::npos) << e;
 }
 
-// Data/Models/icm/metamorphosis.icm (thesis 5.5): K1 the source mesh, K2 it moving onto its
-// stand-in, K3 the space-time blend of the two stand-ins, K4 the destination leaving its
-// stand-in, K5 the destination mesh. Read here with the two stand-ins also shown in K3, so that
-// the blend can be compared with them.
+// Data/Models/icm/metamorphosis.icm (thesis 5.5; T-5.5 of ../shared/spec/thesis_ch5_6.md): K1 the
+// source mesh, K2 it moving onto its stand-in with the weight map sourceTop (z in the file: the
+// top first), K3 the space-time blend of the two stand-ins from the switch on, K4 the destination
+// leaving its stand-in, K5 the destination mesh. The switch K2 -> K3 is the first time every
+// vertex of the source is within 1e-6 of its posed stand-in and every normal within 1 degree of
+// the stand-in's (L3420). Read here with the two stand-ins also shown in K3, so that the blend can
+// be compared with them.
+namespace
+{
+
+struct Metamorphosis
+{
+  std::string text;
+  skin::SkinnedMesh source, target;
+  skin::StandIn sourceStandIn, targetStandIn;
+  skin::Projection sourceProjection, targetProjection;
+  ictk::geometry::Affine sourcePlace, targetPlace;
+
+  Metamorphosis()
+  {
+    std::ifstream in(std::string(ICTK_DATA_DIR) + "/Models/icm/metamorphosis.icm");
+    text.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text.replace(text.find("\"skinned_tube.gltf\""), 19, "\"" + Tube() + "\"");
+    text.replace(
+      text.find("CELLS { Morph; }"), 16, "CELLS { Morph Source_standIn Target_standIn; }");
+    source = skin::readSkinnedMesh(std::string(ICTK_ASSIMP_MODELS) + "/FBX/huesitos.fbx");
+    target = skin::readSkinnedMesh(Tube());
+    sourceStandIn = skin::fittedStandIn(source);
+    targetStandIn = skin::fittedStandIn(target);
+    sourceProjection = skin::projectOntoStandIn(source, sourceStandIn);
+    targetProjection = skin::projectOntoStandIn(target, targetStandIn);
+    sourcePlace =
+      ictk::geometry::Affine::fromTransform({ -1.6, -2.7, 2.6 }, { 0, 0, 0 }, { 0.01, 0.01, 0.01 });
+    targetPlace =
+      ictk::geometry::Affine::fromTransform({ 0, -2.5, 0 }, { 0, 0, 0 }, { 2.5, 2.5, 2.5 });
+  }
+
+  static double smooth(double x)
+  {
+    const double c = std::clamp(x, 0.0, 1.0);
+    return c * c * (3 - 2 * c);
+  }
+
+  /// The model's pose of a mesh at t, made again with the library: alpha delayed per vertex by
+  /// the weight map `axis` of the rest points (spread 1/2).
+  static skin::ProjectedPose poseAt(const skin::SkinnedMesh& mesh, const skin::StandIn& standIn,
+    const skin::Projection& projection, double t, double alpha, int axis)
+  {
+    const auto matrices = skin::jointMatrices(mesh, skin::poseNodes(mesh, &mesh.animations[0], t));
+    std::vector<double> weights;
+    for (const Vec3& p : mesh.restPoints)
+      weights.push_back(p[static_cast<std::size_t>(axis)]);
+    const std::vector<double> delays = skin::projectionDelays(weights, 0.5);
+    std::vector<double> alphas;
+    for (double d : delays)
+      alphas.push_back(skin::delayedAlpha(alpha, d, 0.5));
+    return skin::poseOnStandIn(mesh, projection, matrices, alphas, *posedField(mesh, standIn, t));
+  }
+
+  static ictk::frep::FieldPtr posedField(
+    const skin::SkinnedMesh& mesh, const skin::StandIn& standIn, double t)
+  {
+    const auto matrices = skin::jointMatrices(mesh, skin::poseNodes(mesh, &mesh.animations[0], t));
+    return ictk::frep::tapeField(
+      ictk::frep::Tape::compile(
+        skin::standInShape(skin::poseStandIn(standIn, matrices)).function()),
+      0.0, {});
+  }
+};
+
+/// A mesh cell's world points and normals against a pose made with the library.
+void ExpectMesh(const engine::DynamicModel& m, const std::string& cell,
+  const ictk::geometry::Affine& place, const skin::Posed& want, const std::string& when)
+{
+  const auto cells = m.cells();
+  const auto& shape = *CellOf(cells, cell).shape;
+  const auto& part = shape.parts[0];
+  ASSERT_EQ(part.points.size(), want.points.size());
+  for (std::size_t i = 0; i < want.points.size(); ++i)
+  {
+    const Vec3 got = shape.place.apply(part.points[i]);
+    const Vec3 w = place.apply(want.points[i]);
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(got[c], w[c], 1e-9 * (1 + std::abs(w[c]))) << cell << " " << when;
+  }
+  // The normals (in the cell's frame) go with the points as the array "Normals".
+  const auto normals = std::find_if(part.pointData.begin(), part.pointData.end(),
+    [](const ictk::discretize::PointArray& a) { return a.name == "Normals"; });
+  ASSERT_NE(normals, part.pointData.end()) << cell << " " << when;
+  ASSERT_EQ(normals->values.size(), 3 * want.normals.size());
+  for (std::size_t i = 0; i < want.normals.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(normals->values[3 * i + static_cast<std::size_t>(c)], want.normals[i][c], 1e-9)
+        << cell << " " << when;
+}
+
+} // namespace
+
 TEST(EngineSkeleton, TheMetamorphosisGoesFromTheSourceMeshToTheDestinationMesh)
 {
   if (!skin::canReadSkinnedMeshFiles())
     GTEST_SKIP() << "built without Assimp";
-  std::ifstream in(std::string(ICTK_DATA_DIR) + "/Models/icm/metamorphosis.icm");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  text.replace(text.find("\"skinned_tube.gltf\""), 19, "\"" + Tube() + "\"");
-  text.replace(text.find("CELLS { Morph; }"), 16, "CELLS { Morph Source_standIn Target_standIn; }");
-  engine::DynamicModel m = engine::DynamicModel::load(Write("metamorphosis.icm", text).string());
-  const skin::SkinnedMesh source =
-    skin::readSkinnedMesh(std::string(ICTK_ASSIMP_MODELS) + "/FBX/huesitos.fbx");
-  const skin::SkinnedMesh target = skin::readSkinnedMesh(Tube());
-  const auto sourcePlace =
-    ictk::geometry::Affine::fromTransform({ -1.6, -2.7, 2.6 }, { 0, 0, 0 }, { 0.01, 0.01, 0.01 });
-  const auto targetPlace =
-    ictk::geometry::Affine::fromTransform({ 0, -2.5, 0 }, { 0, 0, 0 }, { 2.5, 2.5, 2.5 });
+  const Metamorphosis x;
   // The projections the engine makes, made again with the library: in the bind pose every
-  // vertex ends on its stand-in (|F| < 1e-9).
-  auto projectionOf = [](const skin::SkinnedMesh& mesh)
+  // vertex ends on its stand-in (|F| < 1e-9) within 10 Newton steps (T-5.5 item 7).
+  EXPECT_EQ(x.sourceProjection.failures, 0);
+  EXPECT_LT(x.sourceProjection.maxResidual, 1e-9);
+  EXPECT_LE(x.sourceProjection.iterations, 10);
+  EXPECT_EQ(x.targetProjection.failures, 0);
+  EXPECT_LT(x.targetProjection.maxResidual, 1e-9);
+  EXPECT_LE(x.targetProjection.iterations, 10);
+  engine::DynamicModel m = engine::DynamicModel::load(Write("metamorphosis.icm", x.text).string());
+  auto plain = [](const skin::SkinnedMesh& mesh, double t)
   {
-    return skin::projectOntoStandIn(mesh, skin::fittedStandIn(mesh));
+    return skin::skin(mesh,
+      skin::jointMatrices(mesh, skin::poseNodes(mesh, &mesh.animations[0], t)), mesh.restPoints,
+      skin::restNormalsOf(mesh));
   };
-  const skin::Projection sourceProjection = projectionOf(source);
-  const skin::Projection targetProjection = projectionOf(target);
-  EXPECT_EQ(sourceProjection.failures, 0);
-  EXPECT_LT(sourceProjection.maxResidual, 1e-9);
-  EXPECT_EQ(targetProjection.failures, 0);
-  EXPECT_LT(targetProjection.maxResidual, 1e-9);
-  // A mesh cell's world points against the library's skinning of the given rest points.
-  auto expectMesh = [&](const std::string& cell, const skin::SkinnedMesh& mesh,
-                      const ictk::geometry::Affine& place, double t, const std::vector<Vec3>& rest)
-  {
-    const auto cells = m.cells();
-    const auto& shape = *CellOf(cells, cell).shape;
-    const auto posed = skin::skin(
-      mesh, skin::jointMatrices(mesh, skin::poseNodes(mesh, &mesh.animations[0], t)), rest);
-    ASSERT_EQ(shape.parts[0].points.size(), posed.points.size());
-    for (std::size_t i = 0; i < posed.points.size(); ++i)
-    {
-      const Vec3 got = shape.place.apply(shape.parts[0].points[i]);
-      const Vec3 want = place.apply(posed.points[i]);
-      for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(got[c], want[c], 1e-9 * (1 + std::abs(want[c]))) << cell << " t " << t;
-    }
-  };
-  // K1: the plain animated source.
+  // K1: the plain animated source, its normals the skinned ones.
   m.advanceTo(0.5, 0.25);
   EXPECT_EQ(m.activeInstance(), "K1");
-  expectMesh("Source", source, sourcePlace, 0.5, source.restPoints);
-  // K2, alpha = 1 from t = 1.5: the source on its stand-in, still skinned.
-  m.advanceTo(1.75, 0.25);
+  ExpectMesh(m, "Source", x.sourcePlace, plain(x.source, 0.5), "t 0.5");
+  // K2 begins at t = 1 with alpha = 0: the plain skinned source still (T-5.5 item 1).
+  m.advanceTo(1.0, 0.25);
   EXPECT_EQ(m.activeInstance(), "K2");
-  expectMesh(
-    "Source", source, sourcePlace, 1.75, skin::projectedRestPoints(source, sourceProjection, 1.0));
-  // K3: the blend is the source's stand-in at t0 = 2 and the destination's from t1 = 3.5 (the
-  // same inside and outside on a grid).
-  for (const auto& [t, operand] : { std::pair<double, const char*>{ 2.0, "Source_standIn" },
-         std::pair<double, const char*>{ 3.75, "Target_standIn" } })
+  ExpectMesh(m, "Source", x.sourcePlace, plain(x.source, 1.0), "t 1");
+  // K2 at 1.25 (alpha = 1/2): the library's pose, the top of the cylinder further on its way.
+  m.advanceTo(1.25, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K2");
+  const skin::ProjectedPose half =
+    Metamorphosis::poseAt(x.source, x.sourceStandIn, x.sourceProjection, 1.25, 0.5, 2);
+  EXPECT_EQ(half.failures, 0);
+  ExpectMesh(m, "Source", x.sourcePlace, half.posed, "t 1.25");
+  // The switch: the first time every vertex is within 1e-6 and every normal within 1 degree. As
+  // alpha = smoothstep(2 (t - 1)) nears 1 at t = 1.5 the last vertices (those of the lowest z,
+  // alpha_i = 2 alpha - 1) come within 1e-6: just before 1.5.
+  double switchTime = -1;
+  for (const engine::FrameRecord& r : m.advanceTo(1.75, 0.25))
+    if (r.transition)
+    {
+      EXPECT_EQ(r.instance, "K3");
+      switchTime = r.time;
+    }
+  std::printf("K2 -> K3 at t = %.9f: residual %.3g, normals within %.3g degrees\n", switchTime,
+    m.value("residualAtSwitch").number, m.value("angleAtSwitch").number);
+  EXPECT_GT(switchTime, 1.49);
+  EXPECT_LE(switchTime, 1.5);
+  EXPECT_EQ(m.value("morphStart").number, switchTime);
+  EXPECT_GE(m.value("residualAtSwitch").number, 0);
+  EXPECT_LT(m.value("residualAtSwitch").number, 1e-6);
+  EXPECT_LT(m.value("angleAtSwitch").number, 1);
+  // The same with the library (T-5.5 item 1): at the switch every vertex satisfies
+  // |F| < 1e-6 |grad F| (world units) and every normal is within 1 degree; a millisecond before,
+  // not all of them.
+  auto residualAt = [&](double t)
   {
-    m.advanceTo(t, 0.25);
-    EXPECT_EQ(m.activeInstance(), "K3");
-    const auto cells = m.cells();
+    const skin::ProjectedPose p = Metamorphosis::poseAt(
+      x.source, x.sourceStandIn, x.sourceProjection, t, Metamorphosis::smooth(2 * (t - 1)), 2);
+    return skin::projectionResidual(
+      p.posed, *Metamorphosis::posedField(x.source, x.sourceStandIn, t), x.sourcePlace);
+  };
+  const skin::ProjectionResidual atSwitch = residualAt(switchTime);
+  EXPECT_LT(atSwitch.distance, 1e-6);
+  EXPECT_LT(atSwitch.degrees, 1);
+  EXPECT_GT(residualAt(switchTime - 1e-3).distance, 1e-6);
+  // No popping (T-5.5 item 2): at the switch the blend is the source's stand-in, on which the
+  // mesh lies (the same inside and outside on a grid); from t1 = 3.5 it is the destination's.
+  engine::DynamicModel atStart =
+    engine::DynamicModel::load(Write("metamorphosis.icm", x.text).string());
+  atStart.advanceTo(switchTime, 0.25);
+  EXPECT_EQ(atStart.activeInstance(), "K3");
+  m.advanceTo(3.75, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K3");
+  for (const auto& [model, operand] :
+    { std::pair<const engine::DynamicModel*, const char*>{ &atStart, "Source_standIn" },
+      std::pair<const engine::DynamicModel*, const char*>{ &m, "Target_standIn" } })
+  {
+    const auto cells = model->cells();
     const auto& morph = *CellOf(cells, "Morph").shape;
     const auto& shape = *CellOf(cells, operand).shape;
     int inside = 0;
@@ -595,18 +707,201 @@ TEST(EngineSkeleton, TheMetamorphosisGoesFromTheSourceMeshToTheDestinationMesh)
             continue;
           inside += f > 0;
           EXPECT_EQ(morph.value({ x, y, z }) > 0, f > 0)
-            << t << " at " << x << " " << y << " " << z;
+            << operand << " at " << x << " " << y << " " << z;
         }
-    EXPECT_GT(inside, 10) << t;
+    EXPECT_GT(inside, 10) << operand;
   }
-  // K4, alpha = 1 until t = 4: the destination on its stand-in; K5: the plain destination.
+  // K4, alpha = 1 at t = 4: the destination on its posed stand-in, normals along it.
   m.advanceTo(4.0, 0.25);
   EXPECT_EQ(m.activeInstance(), "K4");
-  expectMesh(
-    "Target", target, targetPlace, 4.0, skin::projectedRestPoints(target, targetProjection, 1.0));
+  const skin::ProjectedPose on =
+    Metamorphosis::poseAt(x.target, x.targetStandIn, x.targetProjection, 4.0, 1.0, 1);
+  ExpectMesh(m, "Target", x.targetPlace, on.posed, "t 4");
+  const skin::ProjectionResidual r = skin::projectionResidual(
+    on.posed, *Metamorphosis::posedField(x.target, x.targetStandIn, 4.0), x.targetPlace);
+  EXPECT_LT(r.distance, 1e-9);
+  EXPECT_LT(r.degrees, 1e-6);
+  // K4 from t = 4.5, alpha = 0 with every delay: the plain destination already.
+  m.advanceTo(4.75, 0.25);
+  EXPECT_EQ(m.activeInstance(), "K4");
+  ExpectMesh(m, "Target", x.targetPlace, plain(x.target, 4.75), "t 4.75");
+  // K5: the plain destination, points and normals (T-5.5 item 4: 1e-9).
   m.advanceTo(5.5, 0.25);
   EXPECT_EQ(m.activeInstance(), "K5");
-  expectMesh("Target", target, targetPlace, 5.5, target.restPoints);
+  ExpectMesh(m, "Target", x.targetPlace, plain(x.target, 5.5), "t 5.5");
+}
+
+// T-5.5 item 5 in the model: with the weight map sourceTop the vertices of the higher z (in the
+// file) reach the stand-in first. Frames every 0.02 through K2; a vertex is done at the first
+// frame where its distance to the posed stand-in is below 1e-6 (world units).
+TEST(EngineSkeleton, TheWeightMapCollapsesTheTopFirst)
+{
+  if (!skin::canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  const Metamorphosis x;
+  engine::DynamicModel m = engine::DynamicModel::load(Write("metamorphosis.icm", x.text).string());
+  const std::size_t n = x.source.vertexCount();
+  std::vector<double> done(n, -1);
+  m.advanceTo(1.0, 0.25);
+  for (double t = 1.02; t < 1.5 + 1e-9; t += 0.02)
+  {
+    m.advanceTo(t, 0.02);
+    if (m.activeInstance() != "K2")
+      break;
+    const auto cells = m.cells();
+    const auto& shape = *CellOf(cells, "Source").shape;
+    const auto field = Metamorphosis::posedField(x.source, x.sourceStandIn, t);
+    const auto e = field->evaluator();
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      Vec3 g{ 0, 0, 0 };
+      const double f = e->gradient(shape.parts[0].points[i], g);
+      // The placement scales by 0.01: world distance = 0.01 |F| / |grad F|.
+      if (done[i] < 0 && 0.01 * std::abs(f) / std::sqrt(ictk::frep::dot(g, g)) < 1e-6)
+        done[i] = t;
+    }
+  }
+  // The vertices of the top tenth of z (in the file, u_i >= 0.9) and of the bottom tenth: the top
+  // is done when alpha_i = 1, by alpha = 1 - 0.5 * 0.9 = 0.55 (smoothstep(2 (t - 1)) = 0.55 at
+  // t = 1.2667: the frame 1.28); the bottom only as alpha nears 1 (u_i <= 0.1: alpha >= 0.95,
+  // t >= 1.43).
+  double zmin = 1e9, zmax = -1e9;
+  for (const Vec3& p : x.source.restPoints)
+  {
+    zmin = std::min(zmin, p[2]);
+    zmax = std::max(zmax, p[2]);
+  }
+  double topLast = 0, bottomFirst = 2;
+  int top = 0, bottom = 0, inversions = 0, pairs = 0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const double u = (x.source.restPoints[i][2] - zmin) / (zmax - zmin);
+    const double when = done[i] < 0 ? 2.0 : done[i];
+    if (u >= 0.9)
+    {
+      ++top;
+      topLast = std::max(topLast, when);
+    }
+    if (u <= 0.1)
+    {
+      ++bottom;
+      bottomFirst = std::min(bottomFirst, when);
+    }
+    for (std::size_t j = 0; j < n; ++j)
+    {
+      const double uj = (x.source.restPoints[j][2] - zmin) / (zmax - zmin);
+      if (uj > u + 0.1)
+      {
+        ++pairs;
+        inversions += (done[j] < 0 ? 2.0 : done[j]) > when;
+      }
+    }
+  }
+  std::printf("%d top vertices done by t = %.2f, %d bottom ones from t = %.2f; %d of %d pairs "
+              "0.1 apart in u done in the wrong order\n",
+    top, topLast, bottom, bottomFirst, inversions, pairs);
+  EXPECT_GT(top, 0);
+  EXPECT_GT(bottom, 0);
+  EXPECT_LE(topLast, 1.28 + 1e-9);
+  EXPECT_GE(bottomFirst, 1.42);
+  EXPECT_EQ(inversions, 0);
+}
+
+// T-5.5 item 6 in the complex: a skinned cell's normals go with its points as "Normals", and a
+// non-uniform placement, scale(2, 1, 1), maps them by its inverse transpose diag(1/2, 1, 1)
+// (normalised), not by the scale itself. At t = 1 the upper joint has turned an eighth about z:
+// the normals there are no longer along the axes, where the two would agree.
+TEST(EngineSkeleton, TheComplexCarriesTheNormalsByTheInverseTranspose)
+{
+  if (!skin::canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  engine::DynamicModel m = engine::DynamicModel::load(Write("normals.icm",
+    "CELLS { A { type = B-CELL; shape = loadMesh(\"" + Tube() +
+      "\", \"walk\"); dim = 2D; parameters { scale(2, 1, 1); } } }\nK { CELLS { A; } }\n")
+                                                        .string());
+  m.advanceTo(1.0, 0.5);
+  const auto cells = m.cells();
+  const auto& part = CellOf(cells, "A").shape->parts[0];
+  const ictk::complex::Complex cx = m.complex();
+  const auto& g = std::get<ictk::complex::ExplicitGeometry>(cx.cell(0).geometry);
+  auto normalsOf = [](const std::vector<ictk::discretize::PointArray>& arrays)
+  {
+    for (const auto& a : arrays)
+      if (a.name == "Normals")
+        return a.values;
+    return std::vector<double>{};
+  };
+  const std::vector<double> local = normalsOf(part.pointData), world = normalsOf(g.pointData);
+  ASSERT_EQ(local.size(), 3 * part.points.size());
+  ASSERT_EQ(world.size(), local.size());
+  double apartFromTheScale = 0;
+  for (std::size_t i = 0; i < local.size(); i += 3)
+  {
+    const Vec3 n{ 0.5 * local[i], local[i + 1], local[i + 2] };
+    const double k = std::sqrt(ictk::frep::dot(n, n));
+    for (std::size_t c = 0; c < 3; ++c)
+      EXPECT_NEAR(world[i + c], n[c] / k, 1e-15) << "vertex " << i / 3;
+    const Vec3 byScale{ 2 * local[i], local[i + 1], local[i + 2] };
+    const double s = std::sqrt(ictk::frep::dot(byScale, byScale));
+    apartFromTheScale = std::max(apartFromTheScale, std::abs(world[i] - byScale[0] / s));
+  }
+  EXPECT_GT(apartFromTheScale, 0.1);
+}
+
+// What cannot work is refused at its place: a weight map that names no function or a function
+// of the wrong arity or is not quoted, a spread outside [0, 1), a mesh cell with no stand-in, a
+// projection built-in on a cell that is not a mesh.
+TEST(EngineSkeleton, TheCheckerRefusesABadProjection)
+{
+  if (!skin::canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  // Line 4 holds the call; the error's column is that of `mark` in it.
+  auto model = [&](const std::string& call, bool standIn = true)
+  {
+    return "function w2(real x, real y) { return x; }\n"
+           "function top(real x, real y, real z) { return y; }\n"
+           "CELLS { A { type = B-CELL; shape = loadMesh(\"" +
+      Tube() +
+      "\", \"walk\"); dim = 2D;\n"
+      "  REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) { " +
+      call +
+      "; } } }\n"
+      "  B { type = F-CELL; shape = sphere(1); dim = 3D; }\n" +
+      (standIn ? "  S { type = F-CELL; shape = standIn(A); dim = 3D; }\n" : "") + "}\n" +
+      "K { CELLS { A B" + (standIn ? " S" : "") + "; } }\n";
+  };
+  auto at = [](const std::string& call, const std::string& mark)
+  {
+    const std::string line = "  REACTIONS { update(REAL g, REAL l, REAL f, REAL dt) { " + call;
+    return "4:" + std::to_string(line.find(mark) + 1);
+  };
+  struct Case
+  {
+    std::string call, mark, message;
+    bool standIn = true;
+  };
+  for (const Case& c : std::vector<Case>{
+         { "setProjection(A, 0.5, \"nothing\")", "\"nothing\"",
+           "setProjection: no model function named 'nothing'" },
+         { "setProjection(A, 0.5, \"w2\")", "\"w2\"",
+           "setProjection: function 'w2' takes 2 argument(s), and a weight map takes the "
+           "bind-pose position (x, y, z)" },
+         { "setProjection(A, 0.5, 3)", "3",
+           "setProjection's weight map is the name of a model "
+           "function, in quotes" },
+         { "setProjection(A, 0.5, \"top\", 1.5)", "1.5",
+           "setProjection: the spread of the delays is in [0, 1)" },
+         { "setProjection(A, 0.5)", "A,", "setProjection: no cell is the stand-in of 'A'", false },
+         { "real r = projectionResidual(B)", "B)",
+           "projectionResidual takes a skinned mesh cell, and cell 'B' is not one" },
+       })
+  {
+    const std::string e = ErrorOf(model(c.call, c.standIn));
+    EXPECT_EQ(e.substr(0, e.find(' ')), at(c.call, c.mark)) << e;
+    EXPECT_NE(e.find(c.message), std::string::npos) << e;
+  }
+  // A good call passes.
+  EXPECT_EQ(ErrorOf(model("setProjection(A, 0.5, \"top\", 0.25)")), "no error");
 }
 
 // Appendix B's model, Data/Models/icm/standin.icm: BCN_Epileptic carried along +x out of the

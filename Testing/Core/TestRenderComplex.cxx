@@ -390,6 +390,59 @@ TEST(RenderComplex, ScalarAttributeThroughColourMap)
   EXPECT_THROW(ColourMap::named("jet"), std::invalid_argument);
 }
 
+// A mesh cell that brings its vertex normals (the point array "Normals": a skinned B-cell's) is
+// shaded with them. A square in z = 0 seen along -z by a headlight: lit as Ambient + Diffuse |cos|
+// of its normal's angle to the view, so the normals at 60 degrees give the mean of those at 0 and
+// 90 degrees; without the array, the triangles' own normal (0 degrees).
+TEST(RenderComplex, AMeshIsShadedWithItsOwnNormals)
+{
+  auto lightOf = [](const std::vector<double>* normal)
+  {
+    complex::Complex c;
+    complex::ExplicitGeometry g;
+    g.points = { { -0.5, -0.5, 0 }, { 0.5, -0.5, 0 }, { 0.5, 0.5, 0 }, { -0.5, 0.5, 0 } };
+    g.triangles = { { 0, 1, 2 }, { 0, 2, 3 } };
+    if (normal)
+    {
+      discretize::PointArray a{ "Normals", 3, {} };
+      for (int i = 0; i < 4; ++i)
+        a.values.insert(a.values.end(), normal->begin(), normal->end());
+      g.pointData.push_back(a);
+    }
+    const CellId square = c.addCell(complex::explicitCell("square", 2, g));
+    // A scalar colouring keeps the light of every pixel (Canvas::light).
+    c.declareAttribute("material", { 1, { 0 }, { -1 } });
+    bind(c, square, "material", { 1 });
+    complex::DiscretizationOptions o;
+    o.cells = meshedCells(c);
+    const complex::ComplexMesh mesh = complex::discretizeComplex(c, o);
+    const Camera camera = Camera::lookAt(
+      { 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, Projection::Orthographic, 30, 1, 20, 20);
+    ComplexRenderOptions options;
+    options.colours.attribute = "material";
+    const ComplexRenderResult r = renderComplex(c, mesh, camera, options);
+    std::vector<double> lights;
+    for (std::size_t p = 0; p < r.canvas.owner.size(); ++p)
+      if (r.canvas.owner[p] == 0)
+        lights.push_back(r.canvas.light[p]);
+    return lights;
+  };
+  const double s60 = std::sqrt(3.0) / 2;
+  const std::vector<double> facing{ 0, 0, 1 }, tilted{ s60, 0, 0.5 }, edgeOn{ 1, 0, 0 };
+  const std::vector<double> own = lightOf(nullptr), l0 = lightOf(&facing), l60 = lightOf(&tilted),
+                            l90 = lightOf(&edgeOn);
+  ASSERT_EQ(own.size(), 100u); // the square covers 10 x 10 of the 20 x 20 pixels over 2 x 2
+  ASSERT_EQ(l0.size(), own.size());
+  ASSERT_EQ(l60.size(), own.size());
+  ASSERT_EQ(l90.size(), own.size());
+  for (std::size_t i = 0; i < own.size(); ++i)
+  {
+    EXPECT_NEAR(l0[i], own[i], 1e-12);
+    EXPECT_NEAR(l60[i], 0.5 * (l0[i] + l90[i]), 1e-12);
+    EXPECT_LT(l90[i], l0[i] - 0.1);
+  }
+}
+
 TEST(RenderComplex, FlowerShowsEveryDimension)
 {
   const complex::Complex flower =

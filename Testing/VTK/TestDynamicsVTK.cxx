@@ -338,6 +338,13 @@ TEST(DynamicsVTK, SkinnedMeshFramesCarryTheirDominantJoint)
       EXPECT_EQ(joint->GetValue(i), joints[i]) << "vertex " << i;
       EXPECT_EQ(weight->GetValue(i), weights[i]) << "vertex " << i;
     }
+    // The skinned vertex normals are the polydata's normals: the strip lies in z = 0 and turns
+    // about z, so they stay along z.
+    vtkDataArray* normals = strip->GetPointData()->GetNormals();
+    ASSERT_NE(normals, nullptr);
+    ASSERT_EQ(normals->GetNumberOfTuples(), 10);
+    for (vtkIdType i = 0; i < 10; ++i)
+      EXPECT_NEAR(std::abs(normals->GetComponent(i, 2)), 1, 1e-12) << "vertex " << i;
     double bounds[6];
     strip->GetBounds(bounds);
     minX.push_back(bounds[0]);

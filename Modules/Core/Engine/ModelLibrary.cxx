@@ -242,25 +242,105 @@ Value setDeformation(const LibraryCall& call)
   return {};
 }
 
-/// setProjection(cell, alpha): how far the mesh's vertices have moved to their projections.
+/// The loadMesh cell of a projection built-in and the cell of its stand-in.
+std::pair<const CellSpec*, const CellSpec*> projectedCell(const LibraryCall& call)
+{
+  const CellSpec& c = skinnedCell(call);
+  const CellSpec* standIn = c.meshPart == kNone ? nullptr : call.m.standInOf(c.name);
+  if (!standIn)
+    throw std::runtime_error(
+      "no cell has the stand-in of " + c.name + " (shape = standIn(" + c.name + "))");
+  return { &c, standIn };
+}
+
+/// The weight map `name` (a model function of x, y, z) at the cell's rest points.
+std::vector<double> weightMapOf(const LibraryCall& call, const CellSpec& c, const std::string& name)
+{
+  const auto& functions = call.m.model.functions;
+  const auto f = std::find_if(
+    functions.begin(), functions.end(), [&](const Procedure& p) { return p.name.text == name; });
+  if (f == functions.end())
+    throw std::runtime_error("no model function named '" + name +
+      "' (a weight map is a function(real x, real y, real z) of the bind-pose position)");
+  if (f->formals.size() != 3)
+    throw std::runtime_error("function '" + name + "' takes " + std::to_string(f->formals.size()) +
+      " argument(s), and a weight map takes the bind-pose position (x, y, z)");
+  std::vector<double> out;
+  out.reserve(c.skinned->vertexCount());
+  for (const Vec3& p : c.skinned->restPoints)
+  {
+    const Value v = call.m.interpreter.run(
+      *f, { Value::real(p[0]), Value::real(p[1]), Value::real(p[2]) }, call.scope);
+    if (!v.isNumber() || !std::isfinite(v.number))
+      throw std::runtime_error("the weight map '" + name + "' gives the vertex at (" +
+        std::to_string(p[0]) + ", " + std::to_string(p[1]) + ", " + std::to_string(p[2]) +
+        ") no finite number");
+    out.push_back(v.number);
+  }
+  return out;
+}
+
+/// setProjection(cell, alpha [, "weights" [, spread]]): how far the mesh's vertices have moved
+/// to their projections, delayed per vertex by a weight map.
 Value setProjection(const LibraryCall& call)
 {
   ModelState& m = call.m;
-  const CellSpec& c = skinnedCell(call);
-  if (c.meshPart == kNone || !m.standInOf(c.name))
-    throw std::runtime_error("setProjection: no cell has the stand-in of " + c.name +
-      " (shape = standIn(" + c.name + "))");
+  const auto [cell, standIn] = projectedCell(call);
+  const CellSpec& c = *cell;
+  const skin::Projection& projection = *standIn->projection;
+  if (projection.failures > 0)
+    throw std::runtime_error(std::to_string(projection.failures) + " of the " +
+      std::to_string(c.skinned->vertexCount()) + " vertices of " + c.name + " (the first: vertex " +
+      std::to_string(projection.firstFailure) + ") do not reach its stand-in " + standIn->name +
+      " within " + std::to_string(skin::ProjectionOptions{}.maxIterations) +
+      " Newton steps (|F| up to " + std::to_string(projection.maxResidual) + ")");
   const Value& v = call.args.at(1);
   if (!v.isNumber() || !std::isfinite(v.number))
-    throw std::runtime_error("setProjection: alpha is not a finite number");
-  const double alpha = std::clamp(v.number, 0.0, 1.0);
-  const auto it = m.s.projections.find(c.name);
-  if (it == m.s.projections.end() || it->second != alpha)
+    throw std::runtime_error("alpha is not a finite number");
+  ProjectionSetting setting;
+  setting.alpha = std::clamp(v.number, 0.0, 1.0);
+  if (call.args.size() >= 3)
   {
-    m.s.projections[c.name] = alpha;
+    const Value& w = call.args[2];
+    if (w.type != Value::Type::String)
+      throw std::runtime_error("the weight map is the name of a model function, in quotes");
+    setting.weights = w.text;
+    if (!c.weightMaps.count(w.text))
+      c.weightMaps[w.text] = weightMapOf(call, c, w.text);
+  }
+  if (call.args.size() >= 4)
+  {
+    const Value& spread = call.args[3];
+    if (!spread.isNumber() || !(spread.number >= 0 && spread.number < 1))
+      throw std::runtime_error("the spread of the delays is in [0, 1)");
+    setting.spread = spread.number;
+  }
+  const auto it = m.s.projections.find(c.name);
+  if (it == m.s.projections.end() || !(it->second == setting))
+  {
+    m.s.projections[c.name] = setting;
     m.bumpVersion(c.name);
   }
   return {};
+}
+
+/// projectionResidual(cell), projectionAngle(cell): how far the posed mesh is from its posed
+/// stand-in, in world units and degrees.
+Value projectionResidualOf(const LibraryCall& call)
+{
+  ModelState& m = call.m;
+  const auto [cell, standIn] = projectedCell(call);
+  const auto parts = m.partsOf(*cell);
+  const ShapePart& part = (*parts)[cell->meshPart];
+  skin::Posed posed;
+  posed.points = part.points;
+  for (const discretize::PointArray& a : part.pointData)
+    if (a.name == "Normals")
+      for (std::size_t i = 0; i + 2 < a.values.size(); i += 3)
+        posed.normals.push_back({ a.values[i], a.values[i + 1], a.values[i + 2] });
+  const skin::ProjectionResidual r =
+    skin::projectionResidual(posed, *(*m.partsOf(*standIn))[0].field, m.place(cell->name));
+  return Value::real(call.builtin.id == BuiltinId::ProjectionAngle ? r.degrees : r.distance);
 }
 
 Value fireEvent(const LibraryCall& call)
@@ -342,6 +422,8 @@ const std::pair<BuiltinId, LibraryFunction> kLibrary[] = {
   { BuiltinId::JointTransforms, jointTransforms },
   { BuiltinId::SetDeformation, setDeformation },
   { BuiltinId::SetProjection, setProjection },
+  { BuiltinId::ProjectionResidual, projectionResidualOf },
+  { BuiltinId::ProjectionAngle, projectionResidualOf },
 };
 
 } // namespace

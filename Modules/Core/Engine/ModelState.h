@@ -80,6 +80,19 @@ struct OperandNumbers
   double warpSeparation = 0.0;
 };
 
+/// setProjection(cell, alpha [, "weights" [, spread]]): how far a skinned mesh's vertices have
+/// moved to its stand-in (Skin/Projection.h), and the weight map that delays them per vertex.
+struct ProjectionSetting
+{
+  double alpha = 0;
+  std::string weights; ///< a model function of the bind-pose position ("": none)
+  double spread = 0.5;
+  bool operator==(const ProjectionSetting& o) const
+  {
+    return alpha == o.alpha && weights == o.weights && spread == o.spread;
+  }
+};
+
 struct CellSpec
 {
   std::string name;
@@ -134,8 +147,11 @@ struct CellSpec
   std::size_t meshPart = kNone;
   std::vector<skin::Bone> bones;
   mutable double posedAt = kNaN;
-  mutable const void* posedBy = nullptr; ///< the deformation posed by (nullptr: the animation)
-  mutable double posedAlpha = 0;         ///< the projection's fraction posed with
+  mutable const void* posedBy = nullptr;     ///< the deformation posed by (nullptr: the animation)
+  mutable ProjectionSetting posedProjection; ///< the projection posed with
+  /// The weight maps setProjection named (model functions), at the rest points, by name: a
+  /// function of the bind pose, evaluated once.
+  mutable std::map<std::string, std::vector<double>> weightMaps;
   mutable std::shared_ptr<const std::vector<ShapePart>> posed;
   /// standIn(cell): the fitted stand-in of the skinned cell `standInOf` (in its bind pose), its
   /// field part cached for that cell's version.
@@ -202,8 +218,9 @@ struct Structure
   std::map<std::string, Value> texts;                   ///< non-numeric parameters (strings)
   /// setDeformation(cell, transforms): the skinning matrices that pose a skinned cell.
   std::map<std::string, std::shared_ptr<const std::vector<Affine>>> deformations;
-  /// setProjection(cell, alpha): how far a skinned mesh's vertices have moved to its stand-in.
-  std::map<std::string, double> projections;
+  /// setProjection(cell, alpha [, weights [, spread]]): how far a skinned mesh's vertices have
+  /// moved to its stand-in.
+  std::map<std::string, ProjectionSetting> projections;
   /// Cells whose hierarchical parent changed at an instance switch: the offset that keeps their
   /// placement in the world at the switch (ModelState::keepPlacementsAcross).
   std::map<std::string, Affine> keptPlacements;

@@ -162,18 +162,44 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
     const auto deformation = s.deformations.find(c.name);
     const void* by = deformation == s.deformations.end() ? nullptr : deformation->second.get();
     const auto projection = s.projections.find(c.name);
-    const double alpha = projection == s.projections.end() ? 0.0 : projection->second;
-    if (!c.posed || !(c.posedAt == t) || c.posedBy != by || c.posedAlpha != alpha)
+    const ProjectionSetting setting =
+      projection == s.projections.end() ? ProjectionSetting{} : projection->second;
+    if (!c.posed || !(c.posedAt == t) || c.posedBy != by || !(c.posedProjection == setting))
     {
       const std::vector<Affine> matrices = skinningMatrices(c);
       auto posed = std::make_shared<std::vector<ShapePart>>(c.parts);
-      const CellSpec* standIn = alpha > 0 ? standInOf(c.name) : nullptr;
+      const CellSpec* standIn = setting.alpha > 0 ? standInOf(c.name) : nullptr;
       if (c.meshPart != kNone)
-        (*posed)[c.meshPart].points = standIn
-          ? skin::skin(*c.skinned, matrices,
-              skin::projectedRestPoints(*c.skinned, *standIn->projection, alpha))
-              .points
-          : skin::skin(*c.skinned, matrices).points;
+      {
+        const skin::SkinnedMesh& mesh = *c.skinned;
+        ShapePart& part = (*posed)[c.meshPart];
+        skin::Posed pose;
+        if (standIn)
+        {
+          // Thesis 5.5's K2 / K4: on the way to the stand-in posed by the same matrices (its
+          // cell's field, in this cell's frame).
+          std::vector<double> alphas(mesh.vertexCount(), setting.alpha);
+          if (!setting.weights.empty())
+          {
+            const std::vector<double> delays =
+              skin::projectionDelays(c.weightMaps.at(setting.weights), setting.spread);
+            for (std::size_t i = 0; i < alphas.size(); ++i)
+              alphas[i] = skin::delayedAlpha(setting.alpha, delays[i], setting.spread);
+          }
+          pose = skin::poseOnStandIn(
+            mesh, *standIn->projection, matrices, alphas, *(*partsOf(*standIn))[0].field)
+                   .posed;
+        }
+        else
+          pose = skin::skin(mesh, matrices, mesh.restPoints, skin::restNormalsOf(mesh));
+        part.points = std::move(pose.points);
+        // The vertex normals go with the points (the polydata's normals).
+        discretize::PointArray normals{ "Normals", 3, {} };
+        normals.values.reserve(3 * pose.normals.size());
+        for (const Vec3& n : pose.normals)
+          normals.values.insert(normals.values.end(), n.begin(), n.end());
+        part.pointData.push_back(std::move(normals));
+      }
       for (std::size_t i = 0; i < c.bones.size(); ++i)
       {
         // A bone's segment moves with its two joints.
@@ -184,7 +210,7 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
       c.posed = std::move(posed);
       c.posedAt = t;
       c.posedBy = by;
-      c.posedAlpha = alpha;
+      c.posedProjection = setting;
     }
     return c.posed;
   }

@@ -20,6 +20,44 @@ using namespace detail;
 namespace
 {
 
+/// Vertex normals ("Normals", 3 components: a skinned mesh's) are covectors: placed by the
+/// inverse transpose of the placement's linear part, then made unit again.
+void placeNormals(std::vector<discretize::PointArray>& arrays, const Affine& place)
+{
+  if (place.isIdentity())
+  {
+    return;
+  }
+  const Affine inverse = place.inverse();
+  Affine normalMap;
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      normalMap.a[static_cast<std::size_t>(3 * r + c)] =
+        inverse.a[static_cast<std::size_t>(3 * c + r)];
+    }
+  }
+  normalMap.b = { 0, 0, 0 };
+  for (discretize::PointArray& array : arrays)
+  {
+    if (array.name != "Normals" || array.components != 3)
+    {
+      continue;
+    }
+    for (std::size_t i = 0; i + 2 < array.values.size(); i += 3)
+    {
+      const Vec3 n =
+        normalMap.applyLinear({ array.values[i], array.values[i + 1], array.values[i + 2] });
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (std::size_t k = 0; k < 3; ++k)
+      {
+        array.values[i + k] = length > 0 ? n[k] / length : n[k];
+      }
+    }
+  }
+}
+
 /// A shape of mesh parts (.obj/.off files) as the explicit surface it is: its triangles placed.
 complex::Cell meshCell(const PlacedShape& s)
 {
@@ -44,6 +82,7 @@ complex::Cell meshCell(const PlacedShape& s)
   if (s.parts.size() == 1)
   {
     g.pointData = s.parts[0].pointData;
+    placeNormals(g.pointData, s.place);
   }
   complex::Cell cell = complex::explicitCell(s.cell, 2, std::move(g));
   return cell;

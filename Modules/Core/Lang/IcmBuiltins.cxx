@@ -92,10 +92,27 @@ const std::vector<Builtin>& builtins()
       "poses a skinned cell by these skinning matrices (one per joint of its skeleton) instead "
       "of its animation, from now on (Appendix B's `brepCell.setDeformation(transforms)`)" },
     { Id::SetProjection, library,
-      { "setProjection", 2, 2, "setProjection(cell, real alpha)", "void" },
-      "moves the vertices of a `loadMesh` cell the fraction alpha (0..1) of the way to their "
-      "projections onto its stand-in (the `standIn(cell)` cell of it), in the bind pose, before "
-      "skinning them (thesis 5.5's K2 and K4: p'_i = sum_j w_ij M_j (p_i + alpha dp_i))" },
+      { "setProjection", 2, 4, "setProjection(cell, real alpha [, string weights [, real spread]])",
+        "void" },
+      "moves the vertices of a `loadMesh` cell and turns their normals the fraction alpha (0..1) "
+      "of the way onto its stand-in (the `standIn(cell)` cell of it): thesis 5.5's K2 and K4, "
+      "p'_i = sum_j w_ij M_j (p_i + alpha_i dp_i) + alpha_i c_i and n'_i = slerp(A_i^-T "
+      "slerp(n_i, N_i, alpha_i), N'_i, alpha_i), with the offsets dp_i and the stand-in's normals "
+      "N_i found in the bind pose, c_i the posed remainder onto the posed stand-in and N'_i its "
+      "normal there (so alpha = 1 lies on it in every pose). `weights` names "
+      "a model function `(real x, real y, real z)` of the bind-pose position (the file's "
+      "coordinates): its higher values are projected first, over windows of alpha of length "
+      "1 - spread (default 0.5): alpha_i = clamp((alpha - spread (1 - u_i)) / (1 - spread), 0, 1), "
+      "u_i the weight scaled to [0, 1]" },
+    { Id::ProjectionResidual, library,
+      { "projectionResidual", 1, 1, "projectionResidual(cell)", "real" },
+      "how far the posed vertices of a `setProjection` cell are from its posed stand-in: the "
+      "largest abs(F) / length(grad F) over them, in world units (the K2 -> K3 switch of thesis "
+      "L3420: "
+      "every vertex within epsilon when it is below epsilon)" },
+    { Id::ProjectionAngle, library, { "projectionAngle", 1, 1, "projectionAngle(cell)", "real" },
+      "the largest angle, in degrees, between a posed vertex normal of a `setProjection` cell and "
+      "its posed stand-in's outward normal there (-grad F, made unit)" },
     // Vectors.
     { Id::Vec3, math, { "vec3", 3, 3, "vec3(real x, real y, real z)", "vec3" }, "a vector" },
     { Id::Length, math, { "length", 1, 1, "length(vec3 v)", "real" }, "the Euclidean norm" },

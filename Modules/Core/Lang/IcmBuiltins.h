@@ -41,6 +41,8 @@ enum class BuiltinId
   JointTransforms,
   SetDeformation,
   SetProjection,
+  ProjectionResidual,
+  ProjectionAngle,
   Vec3,
   Length,
   Dot,

@@ -716,7 +716,7 @@ Ty Checker::call(const Expr& e, Code& c)
   {
     cellArgs = 2;
   }
-  else if (sig.find("(cell,") != std::string::npos)
+  else if (sig.find("(cell,") != std::string::npos || sig.find("(cell)") != std::string::npos)
   {
     cellArgs = 1;
   }
@@ -743,13 +743,87 @@ Ty Checker::call(const Expr& e, Code& c)
     }
   }
   const bool skeletal = builtin->id == BuiltinId::JointPosition ||
-    builtin->id == BuiltinId::JointTransforms || builtin->id == BuiltinId::SetDeformation ||
-    builtin->id == BuiltinId::SetProjection;
+    builtin->id == BuiltinId::JointTransforms || builtin->id == BuiltinId::SetDeformation;
   if (skeletal && e.kids.size() == 3)
   {
     jointPosition(e, c.cells);
   }
+  const bool projection = builtin->id == BuiltinId::SetProjection ||
+    builtin->id == BuiltinId::ProjectionResidual || builtin->id == BuiltinId::ProjectionAngle;
+  if (projection && e.kids.size() >= 2)
+  {
+    projectionCall(e, c.cells);
+  }
   return resultType(b->result);
+}
+
+void Checker::projectionCall(const Expr& call, const CellMap* cells)
+{
+  const ExprPtr& cell = call.kids[1];
+  if (cell->kind != Expr::Kind::Name)
+  {
+    return;
+  }
+  const Expr* load = loadMeshOf(cell->text, cells);
+  if (!load || load->text != "loadMesh")
+  {
+    err(cell->pos,
+      call.text + " takes a skinned mesh cell, and cell '" + cell->text +
+        "' is not one (shape = loadMesh(...))");
+    return;
+  }
+  // The vertices are projected onto the stand-in of the cell: some cell must be it.
+  bool standIn = false;
+  for (const auto& named : allCells_)
+  {
+    const Property* p = shapeOf(named.first, &allCells_);
+    if (!p)
+    {
+      continue;
+    }
+    for (const ExprPtr& v : p->values)
+    {
+      standIn = standIn ||
+        (v->kind == Expr::Kind::Call && v->text == "standIn" && v->kids.size() == 2 &&
+          v->kids[1]->kind == Expr::Kind::Name && v->kids[1]->text == cell->text);
+    }
+  }
+  if (!standIn)
+  {
+    err(cell->pos,
+      call.text + ": no cell is the stand-in of '" + cell->text + "' (shape = standIn(" +
+        cell->text + "))");
+  }
+  if (call.text != "setProjection" || call.kids.size() < 4)
+  {
+    return;
+  }
+  // The weight map: a model function of the bind-pose position.
+  const ExprPtr& weights = call.kids[3];
+  if (weights->kind != Expr::Kind::String)
+  {
+    err(weights->pos,
+      "setProjection's weight map is the name of a model function, in quotes "
+      "(\"name\" of function name(real x, real y, real z))");
+  }
+  else if (const auto f = functions_.find(weights->text); f == functions_.end())
+  {
+    err(weights->pos,
+      "setProjection: no model function named '" + weights->text +
+        "' (a weight map is a function(real x, real y, real z) of the bind-pose position)");
+  }
+  else if (f->second->formals.size() != 3)
+  {
+    err(weights->pos,
+      "setProjection: function '" + weights->text + "' takes " +
+        std::to_string(f->second->formals.size()) +
+        " argument(s), and a weight map takes the bind-pose position (x, y, z)");
+  }
+  double spread = 0;
+  if (call.kids.size() >= 5 && constantNumber(call.kids[4], spread) && !(spread >= 0 && spread < 1))
+  {
+    err(call.kids[4]->pos, "setProjection: the spread of the delays is in [0, 1)");
+  }
 }
 
 void Checker::jointPosition(const Expr& call, const CellMap* cells)

@@ -178,6 +178,11 @@ private:
   /// jointPosition(cell, "joint"): the cell is a skinned cell and its skeleton has the joint;
   /// jointTransforms(cell, t) and setDeformation(cell, m): the cell is a skinned cell.
   void jointPosition(const Expr& call, const CellMap* cells);
+  /// setProjection(cell, alpha [, "weights" [, spread]]), projectionResidual(cell),
+  /// projectionAngle(cell): the cell is a loadMesh cell with a stand-in (some cell's shape is
+  /// standIn(cell)); the weight map names a model function of three arguments; a constant spread
+  /// is in [0, 1).
+  void projectionCall(const Expr& call, const CellMap* cells);
   static std::string arity(const Signature& b);
 
   // ---- attributes -------------------------------------------------------------------------------

@@ -207,6 +207,18 @@ Primitives primitivesOf(const Cell& cell, const complex::CellMesh& mesh, const C
     default:
       p.triangles = mesh.surface.triangles;
       p.normals = vertexNormals(p.points, p.triangles);
+      // A mesh that brings its vertex normals (a skinned B-cell's, turned towards its stand-in
+      // by setProjection) is shaded with them.
+      for (const auto& a : mesh.pointData())
+      {
+        if (a.name == "Normals" && a.components == 3 && a.values.size() == 3 * p.points.size())
+        {
+          for (std::size_t i = 0; i < p.points.size(); ++i)
+          {
+            p.normals[i] = { a.values[3 * i], a.values[3 * i + 1], a.values[3 * i + 2] };
+          }
+        }
+      }
   }
   return p;
 }

@@ -289,13 +289,22 @@ Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& matrices)
 Posed skin(
   const SkinnedMesh& mesh, const std::vector<Affine>& matrices, const std::vector<Vec3>& restPoints)
 {
+  return skin(mesh, matrices, restPoints, mesh.restNormals);
+}
+
+Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& matrices,
+  const std::vector<Vec3>& restPoints, const std::vector<Vec3>& restNormals)
+{
   if (restPoints.size() != mesh.vertexCount())
     throw std::invalid_argument("skin: " + std::to_string(restPoints.size()) +
       " rest points for a mesh of " + std::to_string(mesh.vertexCount()) + " vertices");
+  if (!restNormals.empty() && restNormals.size() != mesh.vertexCount())
+    throw std::invalid_argument("skin: " + std::to_string(restNormals.size()) +
+      " rest normals for a mesh of " + std::to_string(mesh.vertexCount()) + " vertices");
   Posed out;
   std::size_t count = mesh.vertexCount();
   out.points.resize(count);
-  if (!mesh.restNormals.empty())
+  if (!restNormals.empty())
     out.normals.resize(count);
   for (std::size_t i = 0; i < count; ++i)
   {
@@ -315,7 +324,7 @@ Posed skin(
     {
       Affine normalMap;
       normalMap.a = inverseTranspose(blended.a);
-      Vec3 n = normalMap.applyLinear(mesh.restNormals[i]);
+      Vec3 n = normalMap.applyLinear(restNormals[i]);
       double length = frep::norm(n);
       out.normals[i] = length > 0 ? frep::scale(n, 1 / length) : n;
     }

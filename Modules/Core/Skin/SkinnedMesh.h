@@ -163,6 +163,10 @@ Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& jointMatrices);
 /// p'_i(t) = sum_j w_ij M_j(t) f_alpha(p_i, p_i + dp_i) for vertices moved in the bind pose.
 Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& jointMatrices,
   const std::vector<Vec3>& restPoints);
+/// The same with other rest normals too (thesis 5.5's n'_i(t), L3418, for normals turned in the
+/// bind pose); `restNormals` empty: none.
+Posed skin(const SkinnedMesh& mesh, const std::vector<Affine>& jointMatrices,
+  const std::vector<Vec3>& restPoints, const std::vector<Vec3>& restNormals);
 /// The mesh posed at `seconds` into `animation` (nullptr: the bind pose).
 Posed pose(const SkinnedMesh& mesh, const Animation* animation, double seconds);
 

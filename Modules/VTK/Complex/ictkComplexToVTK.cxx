@@ -82,7 +82,15 @@ vtkSmartPointer<vtkPolyData> toPolyData(const complex::CellMesh& m)
     array->SetNumberOfComponents(a.components);
     array->SetNumberOfTuples(static_cast<vtkIdType>(vertices.size()));
     std::copy(a.values.begin(), a.values.end(), array->GetPointer(0));
-    pd->GetPointData()->AddArray(array);
+    // A mesh's vertex normals (a skinned B-cell's) are the polydata's normals.
+    if (a.name == "Normals" && a.components == 3)
+    {
+      pd->GetPointData()->SetNormals(array);
+    }
+    else
+    {
+      pd->GetPointData()->AddArray(array);
+    }
   }
   return pd;
 }
