@@ -260,6 +260,7 @@ render::Canvas DrawMeshes(const render::ScenePrimitives& scene, const render::Ca
     windowDepths[p] = depths->GetComponent(static_cast<vtkIdType>(p), 0);
   }
   canvas.depth = render::depthFromWindow(windowDepths, camera, clip[0], clip[1]);
+  canvas.normal.clear(); // VTK's pipeline gives no normal buffer: none rather than zeros
   for (std::size_t p = 0; p < windowDepths.size(); ++p)
   {
     if (!std::isfinite(canvas.depth[p]))

@@ -116,6 +116,7 @@ Drawn FromCanvas(render::Canvas&& c)
   d.Covered = c.covered();
   d.Colour = std::move(c.colour);
   d.Depth = std::move(c.depth);
+  d.Normal = std::move(c.normal); // empty for VTK's pictures
   d.Mesh = true; // no interval evaluations to report
   return d;
 }
