@@ -36,6 +36,20 @@ struct Random
   std::mt19937_64 engine;
 };
 
+// Sample s of a region: its low corner, its high corner, then random points inside.
+template <typename Region>
+std::array<double, 4> sampleOf(const Region& region, int s, Random& rng)
+{
+  std::array<double, 4> p;
+  for (int a = 0; a < 4; ++a)
+  {
+    p[a] = s == 0
+      ? region.axes[a].lo
+      : (s == 1 ? region.axes[a].hi : rng.uniform(region.axes[a].lo, region.axes[a].hi));
+  }
+  return p;
+}
+
 // Random trees. `smooth` restricts to everywhere-differentiable operations (for finite
 // differences); otherwise every opcode appears, including the ones that make NaN.
 Expr randomTree(Random& rng, int depth, bool smooth)
@@ -319,13 +333,7 @@ TEST(Evaluators, EveryIntervalEvaluatorEnclosesPointValues)
         PointEvaluator pruned(tape->simplify(choices));
         for (int s = 0; s < 40; ++s)
         {
-          std::array<double, 4> p;
-          for (int a = 0; a < 4; ++a)
-          {
-            p[a] = s == 0
-              ? region.axes[a].lo
-              : (s == 1 ? region.axes[a].hi : rng.uniform(region.axes[a].lo, region.axes[a].hi));
-          }
+          const std::array<double, 4> p = sampleOf(region, s, rng);
           const double v = point.eval(p[0], p[1], p[2], p[3]);
           if (std::isfinite(v))
           {
@@ -471,13 +479,7 @@ TEST(Evaluators, IntervalsEnclosePointSamplesAndPruningKeepsValues)
       PointEvaluator prunedPoint(pruned);
       for (int s = 0; s < 50; ++s)
       {
-        std::array<double, 4> p;
-        for (int a = 0; a < 4; ++a)
-        {
-          p[a] = s == 0
-            ? region.axes[a].lo
-            : (s == 1 ? region.axes[a].hi : rng.uniform(region.axes[a].lo, region.axes[a].hi));
-        }
+        const std::array<double, 4> p = sampleOf(region, s, rng);
         const double v = point.eval(p[0], p[1], p[2], p[3]);
         if (std::isfinite(v))
         {

@@ -9,6 +9,8 @@
 
 #include "FRep/Tape.h"
 
+#include "SkinnedTube.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -65,39 +67,9 @@ SkinnedMesh oneJointTriangle()
   return m;
 }
 
-/// An open tube of radius 0.3 around the z axis for |z| <= 0.6 (24 sides, 7 rings, no normals in
-/// the file), every vertex on the hip joint; the bone goes from the hip (0, 0, -1.5) to the knee
-/// (0, 0, 1.5).
 SkinnedMesh tube()
 {
-  SkinnedMesh m;
-  m.file = "tube";
-  Affine hip, knee, toHip, toKnee;
-  hip.b = { 0, 0, -1.5 };
-  knee.b = { 0, 0, 3 };
-  toHip.b = { 0, 0, 1.5 };
-  toKnee.b = { 0, 0, -1.5 };
-  m.nodes = { { "root", -1, {} }, { "hip", 0, hip }, { "knee", 1, knee } };
-  m.joints = { { 1, toHip }, { 2, toKnee } };
-  const int sides = 24, rings = 7;
-  for (int k = 0; k < rings; ++k)
-    for (int i = 0; i < sides; ++i)
-    {
-      const double a = 2 * pi * i / sides;
-      m.restPoints.push_back(
-        { 0.3 * std::cos(a), 0.3 * std::sin(a), -0.6 + 1.2 * k / (rings - 1) });
-      m.influences.push_back({ 0, 1.0 });
-      m.influenceStart.push_back(m.influences.size());
-    }
-  for (int k = 0; k + 1 < rings; ++k)
-    for (int i = 0; i < sides; ++i)
-    {
-      const int p = k * sides + i, q = k * sides + (i + 1) % sides;
-      m.triangles.push_back({ p, q, q + sides });
-      m.triangles.push_back({ p, q + sides, p + sides });
-    }
-  m.validate();
-  return m;
+  return fixtures::skinnedTube(24, 7);
 }
 
 /// The tube's stand-in, thinner than the tube (radius 0.2) so that every vertex has 0.1 to go.

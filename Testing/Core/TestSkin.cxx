@@ -13,6 +13,8 @@
 #include "FRep/Evaluators.h"
 #include "FRep/Tape.h"
 
+#include "SkinnedTube.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -404,35 +406,9 @@ TEST(SkinFile, BadFilesNameTheFile)
 namespace
 {
 
-/// An open tube of radius 0.3 around the z axis for |z| <= 0.6 (40 sides, 13 rings), skinned to
-/// a bone from (0, 0, -1.5) to (0, 0, 1.5): its joints' offsets are the translations that bring
-/// their markers to the origin.
 SkinnedMesh tube()
 {
-  SkinnedMesh m;
-  m.file = "tube";
-  m.nodes = { { "root", -1, {} }, { "hip", 0, translation(0, 0, -1.5) },
-    { "knee", 1, translation(0, 0, 3) } };
-  m.joints = { { 1, translation(0, 0, 1.5) }, { 2, translation(0, 0, -1.5) } };
-  const int sides = 40, rings = 13;
-  for (int k = 0; k < rings; ++k)
-    for (int i = 0; i < sides; ++i)
-    {
-      double a = 2 * pi * i / sides;
-      m.restPoints.push_back(
-        { 0.3 * std::cos(a), 0.3 * std::sin(a), -0.6 + 1.2 * k / (rings - 1) });
-      m.influences.push_back({ 0, 1.0 });
-      m.influenceStart.push_back(m.influences.size());
-    }
-  for (int k = 0; k + 1 < rings; ++k)
-    for (int i = 0; i < sides; ++i)
-    {
-      int p = k * sides + i, q = k * sides + (i + 1) % sides;
-      m.triangles.push_back({ p, q, q + sides });
-      m.triangles.push_back({ p, q + sides, p + sides });
-    }
-  m.validate();
-  return m;
+  return fixtures::skinnedTube(40, 13);
 }
 
 double fieldAt(const ictk::frep::Shape& shape, const Vec3& p)
