@@ -790,12 +790,19 @@ IncrementalIntervalEvaluator::IncrementalIntervalEvaluator(
     const double v = tape_->constants()[i];
     values_[tape_->constantBase() + i] = { v, v, std::isnan(v) };
   }
+  setParameters(parameters);
+}
+
+void IncrementalIntervalEvaluator::setParameters(const std::vector<double>& parameters)
+{
   std::vector<double> p;
   loadParameters(*tape_, parameters, p);
   for (std::size_t i = 0; i < p.size(); ++i)
   {
     values_[tape_->parameterBase() + i] = { p[i], p[i], std::isnan(p[i]) };
   }
+  // The instructions record the axes they depend on, not the parameters: all run again.
+  first_ = true;
 }
 
 Interval IncrementalIntervalEvaluator::eval(const Region& region)
@@ -833,9 +840,16 @@ IncrementalPointEvaluator::IncrementalPointEvaluator(
 {
   std::copy(
     tape_->constants().begin(), tape_->constants().end(), values_.begin() + tape_->constantBase());
+  setParameters(parameters);
+}
+
+void IncrementalPointEvaluator::setParameters(const std::vector<double>& parameters)
+{
   std::vector<double> p;
   loadParameters(*tape_, parameters, p);
   std::copy(p.begin(), p.end(), values_.begin() + tape_->parameterBase());
+  // As IncrementalIntervalEvaluator::setParameters: everything runs again.
+  first_ = true;
 }
 
 double IncrementalPointEvaluator::eval(double x, double y, double z, double t)

@@ -125,6 +125,8 @@ class IncrementalIntervalEvaluator
 {
 public:
   explicit IncrementalIntervalEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  /// New parameter values; the next eval runs every instruction.
+  void setParameters(const std::vector<double>& parameters);
   Interval eval(const Region& region);
   const std::vector<Choice>& choices() const { return choices_; }
   TapePtr simplified() const { return tape_->simplify(choices_); }
@@ -144,6 +146,8 @@ class IncrementalPointEvaluator
 {
 public:
   explicit IncrementalPointEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  /// New parameter values; the next eval runs every instruction.
+  void setParameters(const std::vector<double>& parameters);
   double eval(double x, double y, double z = 0, double t = 0);
   const TapePtr& tape() const { return tape_; }
 
