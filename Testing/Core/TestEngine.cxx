@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -282,6 +283,93 @@ TEST(EngineExemplars, AndyhausenRunsItsWholeFilm)
     EXPECT_EQ(m.activeInstance(), "ANDY_OUT");
     EXPECT_NEAR(real(m, "Skeleton.translation.y"), 2.430625, 1e-4);
     EXPECT_NEAR(real(m, "Skeleton.height"), 2.430625, 1e-4);
+  }
+}
+
+// ANDY_OUT's character (issue 17): BCN_Epileptic on the hook, scaled 0.75 and climbing with
+// skeletonAnim; her left hand takes Handle2 and turns it, and the handles turn together through
+// the bidirectional dependency. By hand: in ANDY_OUT the handles rest at alpha = 12 - 2 x
+// 6.346875 = -0.69375 and the hook at y = -0.6 - 0.4 x 6.346875 = -3.13875. After 3.3 s of the
+// instance the skeleton is in its bind pose, where the hand is at 0.75 (0.218128, -0.0719957,
+// -0.136143) from the skeleton's origin; the skeleton is moved by (0.7 - 0.75 x 0.218128, k,
+// 0.75 x 0.136143) from the hook, so the hand is at (0.7, -3.13875 + k - 0.0539968, 0), under
+// Handle2's centre (0.7, -1.2, 0). It takes the handle 0.3 from it, at y = -1.5: k = 1.6927468,
+// which skeletonAnim (0.5 at 4 s, +0.2 a second after) reaches at 4 + 1.1927468 / 0.2 =
+// 9.963734 s into ANDY_OUT, t = 16.310609. Before that the handles do not move; after it they
+// turn at the hand's rate, 1 a second, from the step the hand takes the handle (at most dt later).
+TEST(EngineExemplars, AndyhausensAndyTakesTheSecondHandleAndTurnsBoth)
+{
+  if (!std::ifstream("/usr/share/assimp/models/X/BCN_Epileptic.X"))
+    GTEST_SKIP() << "Debian's assimp-testmodels is not installed";
+  DynamicModel m = load("andyhausen.icm");
+  const double dt = 0.1, switchT = 6.346875, reachT = 16.310609;
+  const double restAngle = 12 - 2 * switchT;
+  double takenAt = -1;
+  for (int k = 1; k <= 200; ++k)
+  {
+    const double t = dt * k;
+    m.advanceTo(t, dt);
+    if (t < switchT)
+      continue;
+    ASSERT_EQ(m.activeInstance(), "ANDY_OUT") << "t = " << t;
+    const bool holding = m.value("Andy.holding").number != 0;
+    if (t < reachT)
+    {
+      EXPECT_FALSE(holding) << "t = " << t;
+      EXPECT_NEAR(real(m, "Handle2.alpha"), restAngle, 1e-6) << "t = " << t;
+      EXPECT_NEAR(real(m, "Handle1.alpha"), restAngle, 1e-6) << "t = " << t;
+      continue;
+    }
+    if (!holding)
+    {
+      EXPECT_LT(t, reachT + dt) << "the hand has not taken the handle";
+      continue;
+    }
+    if (takenAt < 0)
+      takenAt = switchT + real(m, "Andy.reachT");
+    // From the step the hand took it, the handle turns at 1 a second, and Handle1 with it.
+    const double angle = restAngle + (t - takenAt);
+    EXPECT_NEAR(real(m, "Handle2.alpha"), angle, 1e-6) << "t = " << t;
+    EXPECT_NEAR(real(m, "Handle1.alpha"), angle, 1e-6) << "t = " << t;
+  }
+  std::printf("Andy takes Handle2 at t = %.6f; Handle1.alpha %.6f at t = 20\n", takenAt,
+    real(m, "Handle1.alpha"));
+  EXPECT_GE(takenAt, reachT - 1e-4);
+  EXPECT_LT(takenAt, reachT + dt + 1e-4);
+  // The last step, t = 20: turned by 20 - takenAt (3.6 to 3.7) since the hand took it.
+  EXPECT_GT(real(m, "Handle1.alpha"), restAngle + 3.5);
+}
+
+// Without the character's file the model is refused at load, naming the file at the place (line
+// and column) of the first call that reads it.
+TEST(EngineExemplars, AndyhausenWithoutItsCharacterFileIsRefusedNamingIt)
+{
+  std::ifstream in(models + "andyhausen.icm");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string file = "/usr/share/assimp/models/X/BCN_Epileptic.X";
+  const std::string missing = "/usr/share/assimp/models/X/BCN_Missing.X";
+  const std::size_t first = text.find(file);
+  ASSERT_NE(first, std::string::npos);
+  const auto line =
+    1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(first), '\n');
+  const auto column = first - text.rfind('\n', first); // 1-based, at the string's quote
+  for (std::size_t at = first; at != std::string::npos; at = text.find(file, at))
+    text.replace(at, file.size(), missing);
+  const std::string path = ::testing::TempDir() + "andyhausen_missing.icm";
+  std::ofstream(path) << text;
+  try
+  {
+    DynamicModel::load(path);
+    ADD_FAILURE() << "loaded without " << missing;
+  }
+  catch (const std::exception& e)
+  {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(missing), std::string::npos) << what;
+    EXPECT_NE(what.find("andyhausen_missing.icm:" + std::to_string(line) + ":" +
+                std::to_string(column - 1)),
+      std::string::npos)
+      << what;
   }
 }
 

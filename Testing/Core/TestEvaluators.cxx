@@ -537,6 +537,110 @@ TEST(Evaluators, IncrementalEvaluationMatchesFullEvaluationBitForBit)
   EXPECT_GT(reused, TreeCount * 20);
 }
 
+TEST(Evaluators, ReboundParametersGiveWhatTheirValuesCompiledAsConstantsGive)
+{
+  // A model whose numbers move (a skeleton's joints) compiles once with Expr::parameter leaves
+  // and rebinds them per frame. Every evaluator, rebound from other values after use, must give
+  // bit for bit what a new one gives; the double ones also what the tape with those values as
+  // constants gives (constant folding runs the evaluators' own operations). Random trees with t
+  // replaced by a mix of parameters and coordinates (with values never 0 or +-1, where folding
+  // would apply an identity that the parameters' tape does not).
+  Random rng(12);
+  const Expr p0 = Expr::parameter(0), p1 = Expr::parameter(1), p2 = Expr::parameter(2);
+  for (int n = 0; n < TreeCount; ++n)
+  {
+    const Expr tree = randomTree(rng, 6, false);
+    const auto bound = [&](const Expr& a, const Expr& b, const Expr& c)
+    {
+      return tree.substitute(
+        { Expr::x(), Expr::y(), Expr::z(), a * Expr::z() - b * Expr::x() + sin(c) });
+    };
+    const TapePtr tape = Tape::compile(bound(p0, p1, p2));
+    const auto values = [&]
+    {
+      std::vector<double> q(3);
+      for (double& v : q)
+        v = (rng.index(2) ? 1 : -1) * rng.uniform(0.1, 0.9) * (rng.index(2) ? 1 : 3);
+      return q;
+    };
+    const std::vector<double> before = values(), q = values();
+    const TapePtr constants = Tape::compile(bound(Expr(q[0]), Expr(q[1]), Expr(q[2])));
+
+    PointEvaluator point(tape, before), pointConstants(constants);
+    IncrementalPointEvaluator incremental(tape, before);
+    GradientEvaluator gradient(tape, before), gradientConstants(constants);
+    BatchEvaluator<double> batch(tape, before), batchConstants(constants);
+    BatchEvaluator<float> batchF(tape, before), batchFFresh(tape, q);
+    IntervalEvaluator interval(tape, before), intervalFresh(tape, q);
+    IncrementalIntervalEvaluator incrementalInterval(tape, before);
+    std::vector<double> xs(40), ys(40), zs(40), out(40), outConstants(40);
+    std::vector<float> xf(40), yf(40), zf(40), outF(40), outFFresh(40);
+    for (std::size_t i = 0; i < xs.size(); ++i)
+    {
+      xs[i] = rng.uniform(-3, 3);
+      ys[i] = rng.uniform(-3, 3);
+      zs[i] = rng.uniform(-3, 3);
+      xf[i] = static_cast<float>(xs[i]);
+      yf[i] = static_cast<float>(ys[i]);
+      zf[i] = static_cast<float>(zs[i]);
+    }
+    Region region;
+    region.axes = { Interval{ -1, 0.5 }, Interval{ 0.25, 2 }, Interval{ -2, -1 },
+      Interval{ 0, 0 } };
+    // Used with the values before, so that stale values would show.
+    point.eval(xs[0], ys[0], zs[0]);
+    incremental.eval(xs[0], ys[0], zs[0]);
+    gradient.eval(xs[0], ys[0], zs[0]);
+    batch.eval(xs.data(), ys.data(), zs.data(), nullptr, out.data(), xs.size());
+    batch.evalRowX(-1, 0.1, 0, 0.5, 0.5, 0, out.data(), out.size());
+    batchF.eval(xf.data(), yf.data(), zf.data(), nullptr, outF.data(), xf.size());
+    interval.eval(region);
+    incrementalInterval.eval(region);
+    point.setParameters(q);
+    incremental.setParameters(q);
+    gradient.setParameters(q);
+    batch.setParameters(q);
+    batchF.setParameters(q);
+    interval.setParameters(q);
+    incrementalInterval.setParameters(q);
+
+    const std::string what = toString(bound(p0, p1, p2));
+    for (std::size_t i = 0; i < xs.size(); ++i)
+    {
+      const double v = pointConstants.eval(xs[i], ys[i], zs[i]);
+      ASSERT_TRUE(sameDouble(v, point.eval(xs[i], ys[i], zs[i]))) << what;
+      ASSERT_TRUE(sameDouble(v, incremental.eval(xs[i], ys[i], zs[i]))) << what;
+      const ValueGradient g = gradient.eval(xs[i], ys[i], zs[i]);
+      const ValueGradient h = gradientConstants.eval(xs[i], ys[i], zs[i]);
+      ASSERT_TRUE(sameDouble(g.value, h.value)) << what;
+      for (int a = 0; a < 4; ++a)
+        ASSERT_TRUE(sameDouble(g.gradient[a], h.gradient[a])) << what;
+    }
+    batch.eval(xs.data(), ys.data(), zs.data(), nullptr, out.data(), xs.size());
+    batchConstants.eval(xs.data(), ys.data(), zs.data(), nullptr, outConstants.data(), xs.size());
+    for (std::size_t i = 0; i < xs.size(); ++i)
+      ASSERT_TRUE(sameDouble(out[i], outConstants[i])) << what;
+    batch.evalRowX(-1, 0.1, 0, 0.5, 0.5, 0, out.data(), out.size());
+    batchConstants.evalRowX(-1, 0.1, 0, 0.5, 0.5, 0, outConstants.data(), out.size());
+    for (std::size_t i = 0; i < out.size(); ++i)
+      ASSERT_TRUE(sameDouble(out[i], outConstants[i])) << what;
+    batchF.eval(xf.data(), yf.data(), zf.data(), nullptr, outF.data(), xf.size());
+    batchFFresh.eval(xf.data(), yf.data(), zf.data(), nullptr, outFFresh.data(), xf.size());
+    for (std::size_t i = 0; i < outF.size(); ++i)
+      ASSERT_TRUE(std::memcmp(&outF[i], &outFFresh[i], sizeof(float)) == 0 ||
+        (std::isnan(outF[i]) && std::isnan(outFFresh[i])))
+        << what;
+    const Interval a = interval.eval(region), b = intervalFresh.eval(region),
+                   c = incrementalInterval.eval(region);
+    ASSERT_TRUE(sameDouble(a.lo, b.lo) && sameDouble(a.hi, b.hi) && a.maybeNaN == b.maybeNaN)
+      << what;
+    ASSERT_TRUE(sameDouble(c.lo, b.lo) && sameDouble(c.hi, b.hi) && c.maybeNaN == b.maybeNaN)
+      << what;
+    ASSERT_EQ(interval.choices(), intervalFresh.choices()) << what;
+    ASSERT_EQ(incrementalInterval.choices(), intervalFresh.choices()) << what;
+  }
+}
+
 TEST(Evaluators, PruningCutsTheLosingBranchOfAUnion)
 {
   // max(sphere at -2, sphere at +2): near x = +2 only the second sphere matters.

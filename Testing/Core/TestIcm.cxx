@@ -339,12 +339,16 @@ TEST(IcmModels, Andyhausen)
   const auto& use = m.instances[1].cells[0].uses[0];
   ASSERT_EQ(use.minus.size(), 1u);
   EXPECT_EQ(use.minus[0].text, "Melting_egg");
-  // ANDY_OUT: the hand turns the handle through an indexed path.
+  // ANDY_OUT: the skeleton on the hook, Andy on the skeleton and posed by its matrices, and the
+  // hand's angle turning the handle (the thesis' indexed path Andy.skeleton["hand"].rotationZ is
+  // read in its fixture appC_andyhausen_instance3_ANDY_OUT.icm).
   const auto& andy = m.instances[3].relations[0].dependency;
   ASSERT_EQ(andy.size(), 4u);
   EXPECT_TRUE(andy[0].hierarchical);
+  EXPECT_TRUE(andy[1].hierarchical);
   EXPECT_EQ(andy[3].ends[0]->kind, icm::Expr::Kind::Member);
-  EXPECT_EQ(andy[3].ends[0]->text, "rotationZ");
+  EXPECT_EQ(andy[3].ends[0]->text, "handAngle");
+  EXPECT_EQ(andy[3].ends[1]->text, "alpha");
   EXPECT_EQ(m.instances[3].relations[0].dependencyUses[0].minus.size(), 2u);
   // The egg's containment.
   ASSERT_EQ(m.instances[1].relations[0].containment.size(), 1u);

@@ -294,6 +294,11 @@ TEST_P(JitTest, ParametersAndSeveralOutputs)
   reference.evalRowX(-1.0, 0.05, 0, 0.5, 0, 0, e.data(), 40);
   jit.evalRowX(-1.0, 0.05, 0, 0.5, 0, 0, g.data(), 40);
   EXPECT_EQ(countDifferent(e, g, "after setParameters"), 0);
+  // Rebound, the JIT gives what a new evaluator with these values gives.
+  BatchEvaluator<float> fresh(tape, { -2.0, 4.0 });
+  std::vector<float> f(40);
+  fresh.evalRowX(-1.0, 0.05, 0, 0.5, 0, 0, f.data(), 40);
+  EXPECT_EQ(countDifferent(f, g, "rebound against new"), 0);
   EXPECT_THROW(JitEvaluator(tape, { 1.0 }, options), std::invalid_argument);
   // The first output constant along the row, the second varying; only the first asked.
   JitEvaluator mixed(Tape::compile(std::vector<Expr>{ y * 2.0, x + y }), {}, options);

@@ -17,10 +17,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 using namespace ictk::skin;
 
@@ -486,6 +489,82 @@ TEST(StandIn, EpilepticsStandInFitsAndFollowsTheSkeleton)
       expectNear(g.b, globals[static_cast<std::size_t>(m.joints[g.joint].node)].b, 1e-9, "end");
     }
   }
+}
+
+// The posed stand-in's field from one tape whose segments' ends, widths and weights are
+// parameters, rebound every frame: at every frame of the animation (each tick) and every skinned
+// vertex it equals, bit for bit, the field of the posed stand-in compiled with its numbers as
+// constants (what every frame did before). The ends are still the skinned joints' origins.
+TEST(StandIn, OneTapeReboundAtEveryFrameGivesTheRecompiledFieldBitForBit)
+{
+  if (!canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  SkinnedMesh m = readSkinnedMesh(model("X/BCN_Epileptic.X"));
+  const StandIn s = fittedStandIn(m);
+  const StandInField field(s.segments.size());
+  EXPECT_EQ(field.tape()->parameterCount(), StandInField::ParametersPerSegment * s.segments.size());
+  // Its frames: every key time of every channel (the poses the file gives) and 25 a second
+  // between them.
+  const Animation& a = m.animation("Epileptisch");
+  std::set<double> ticks;
+  for (const Channel& c : a.channels)
+  {
+    for (const VectorKey& k : c.positions)
+      ticks.insert(k.time);
+    for (const RotationKey& k : c.rotations)
+      ticks.insert(k.time);
+    for (const VectorKey& k : c.scales)
+      ticks.insert(k.time);
+  }
+  for (double tick = 0; tick <= a.duration; tick += a.ticksPerSecond / 25)
+    ticks.insert(tick);
+  const int frames = static_cast<int>(ticks.size());
+  ASSERT_GT(frames, 80);
+  ictk::frep::BatchEvaluator<double> rebound(field.tape(), field.parameters(s));
+  const std::size_t n = m.vertexCount();
+  std::vector<double> x(n), y(n), z(n), got(n), want(n);
+  std::size_t different = 0, inside = 0;
+  double farthestEnd = 0;
+  for (const double tick : ticks)
+  {
+    const double t = tick / a.ticksPerSecond;
+    const std::vector<Affine> globals = poseNodes(m, &a, t);
+    const std::vector<Affine> matrices = jointMatrices(m, globals);
+    const StandIn posed = poseStandIn(s, matrices);
+    const Posed mesh = skin(m, matrices);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      x[i] = mesh.points[i][0];
+      y[i] = mesh.points[i][1];
+      z[i] = mesh.points[i][2];
+    }
+    rebound.setParameters(field.parameters(posed));
+    rebound.eval(x.data(), y.data(), z.data(), nullptr, got.data(), n);
+    ictk::frep::BatchEvaluator<double> recompiled(
+      ictk::frep::Tape::compile(standInShape(posed).function()));
+    recompiled.eval(x.data(), y.data(), z.data(), nullptr, want.data(), n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      different += std::memcmp(&got[i], &want[i], sizeof(double)) != 0 ? 1 : 0;
+      inside += got[i] >= 0 ? 1 : 0;
+    }
+    for (const StandInSegment& g : posed.segments)
+    {
+      const Vec3& start = globals[static_cast<std::size_t>(m.joints[g.parentJoint].node)].b;
+      const Vec3& end = globals[static_cast<std::size_t>(m.joints[g.joint].node)].b;
+      for (int c = 0; c < 3; ++c)
+        farthestEnd =
+          std::max({ farthestEnd, std::abs(g.a[c] - start[c]), std::abs(g.b[c] - end[c]) });
+    }
+  }
+  EXPECT_EQ(different, 0u) << "of " << n * static_cast<std::size_t>(frames);
+  EXPECT_LE(farthestEnd, 1e-9);
+  // The stand-in is embedded, so few vertices have F >= 0 (its working range, not a constant).
+  std::printf("%d frames x %zu vertices, %zu with F >= 0\n", frames, n, inside);
+  EXPECT_LT(inside, n * static_cast<std::size_t>(frames) / 10);
+  StandIn fewer = s;
+  fewer.segments.pop_back();
+  EXPECT_THROW(field.parameters(fewer), std::invalid_argument);
 }
 
 // Thesis L3276: the stand-in "fully embedded" in the mesh. The embedded fit keeps F <= -margin

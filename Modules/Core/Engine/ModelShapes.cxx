@@ -347,6 +347,7 @@ void ModelState::fitStandIns()
       skin::StandIn standIn = skin::fittedStandIn(*mesh.skinned);
       c.projection =
         std::make_shared<const skin::Projection>(skin::projectOntoStandIn(*mesh.skinned, standIn));
+      c.standInField = std::make_shared<const skin::StandInField>(standIn.segments.size());
       c.standIn = std::make_shared<const skin::StandIn>(std::move(standIn));
     }
     catch (const std::exception& e)
@@ -375,6 +376,7 @@ void ModelState::buildShape(CellSpec& c, const Property& p)
   c.posed.reset();
   c.standInOf.clear();
   c.standIn.reset();
+  c.standInField.reset();
   c.standInParts.reset();
   if (p.isHyperFun)
   {

@@ -158,6 +158,8 @@ struct CellSpec
   std::string standInOf;
   Pos standInPos;
   std::shared_ptr<const skin::StandIn> standIn;
+  /// Its field's tape, compiled once: each pose binds the segments' ends (StandInField).
+  std::shared_ptr<const skin::StandInField> standInField;
   /// The mesh cell's vertices projected onto the stand-in (bind pose; setProjection).
   std::shared_ptr<const skin::Projection> projection;
   mutable std::uint64_t standInVersion = 0;

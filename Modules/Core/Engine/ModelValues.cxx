@@ -224,8 +224,7 @@ std::shared_ptr<const std::vector<ShapePart>> ModelState::partsOf(const CellSpec
       const skin::StandIn posed = skin::poseStandIn(*c.standIn, skinningMatrices(mesh));
       ShapePart part;
       part.kind = ShapePart::Kind::Field;
-      part.field = frep::tapeField(
-        frep::Tape::compile(skin::standInShape(posed).function()), 0.0, std::vector<double>{});
+      part.field = frep::tapeField(c.standInField->tape(), 0.0, c.standInField->parameters(posed));
       part.bounds = c.hasDomain ? c.domain : skin::standInBounds(posed);
       c.standInParts = std::make_shared<const std::vector<ShapePart>>(1, part);
       c.standInVersion = version;

@@ -224,74 +224,66 @@ BatchEvaluator<T>::BatchEvaluator(TapePtr tape, const std::vector<double>& param
   : tape_(std::move(tape))
 {
   loadParameters(*tape_, parameters, parameters_);
-  prepare();
-}
-
-template <typename T>
-void BatchEvaluator<T>::setParameters(const std::vector<double>& parameters)
-{
-  loadParameters(*tape_, parameters, parameters_);
-  prepare();
-}
-
-template <typename T>
-void BatchEvaluator<T>::prepareFull()
-{
-  const Tape& tape = *tape_;
-  // Full tape: leaves in fixed slots, constants and parameters broadcast once.
-  storage_.assign(static_cast<std::size_t>(tape.slotCount()) * ChunkSize, T(0));
-  slots_.resize(tape.slotCount());
-  for (std::uint32_t i = 0; i < tape.slotCount(); ++i)
-  {
-    slots_[i] = storage_.data() + static_cast<std::size_t>(i) * ChunkSize;
-  }
-  auto fill = [&](std::uint32_t slot, double v)
-  {
-    std::fill_n(slots_[slot], ChunkSize, static_cast<T>(v));
-  };
-  for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
-  {
-    fill(tape.parameterBase() + i, parameters_[i]);
-  }
-  for (std::size_t i = 0; i < tape.constants().size(); ++i)
-  {
-    fill(tape.constantBase() + static_cast<std::uint32_t>(i), tape.constants()[i]);
-  }
-  fullReady_ = true;
-}
-
-template <typename T>
-void BatchEvaluator<T>::prepare()
-{
-  const Tape& tape = *tape_;
-  // eval()'s slots are set up on first use: evalRowX alone (grid sampling, rendering) does not
-  // need them, and for a large tape they are most of the set-up cost.
-  fullReady_ = false;
   // Row program along x.
-  row_ = tape.rowProgram(1u << static_cast<int>(Axis::X));
+  row_ = tape_->rowProgram(1u << static_cast<int>(Axis::X));
   rowStorage_.assign(static_cast<std::size_t>(row_.chunkSlotCount) * ChunkSize, T(0));
   rowSlots_.resize(row_.chunkSlotCount);
   for (std::uint32_t i = 0; i < row_.chunkSlotCount; ++i)
   {
     rowSlots_[i] = rowStorage_.data() + static_cast<std::size_t>(i) * ChunkSize;
   }
-  scalars_.assign(row_.scalarSlotCount, T(0));
+  loadValues(row_, scalars_, rowSlots_);
+}
+
+template <typename T>
+void BatchEvaluator<T>::setParameters(const std::vector<double>& parameters)
+{
+  loadParameters(*tape_, parameters, parameters_);
+  loadValues(row_, scalars_, rowSlots_);
+  if (pointsReady_)
+  {
+    loadValues(points_, pointScalars_, pointSlots_);
+  }
+}
+
+template <typename T>
+void BatchEvaluator<T>::loadValues(
+  const RowProgram& program, std::vector<T>& scalars, const std::vector<T*>& chunks)
+{
+  const Tape& tape = *tape_;
+  scalars.assign(program.scalarSlotCount, T(0));
   for (std::uint32_t i = 0; i < tape.parameterCount(); ++i)
   {
-    scalars_[tape.parameterBase() + i] = static_cast<T>(parameters_[i]);
+    scalars[tape.parameterBase() + i] = static_cast<T>(parameters_[i]);
   }
   for (std::size_t i = 0; i < tape.constants().size(); ++i)
   {
-    scalars_[tape.constantBase() + i] = static_cast<T>(tape.constants()[i]);
+    scalars[tape.constantBase() + i] = static_cast<T>(tape.constants()[i]);
   }
-  // Values that depend on no coordinate are the same for every row: broadcast them now (the
-  // uniform code computes them whatever the coordinates are).
-  runScalar(row_.uniform, scalars_.data());
-  for (const auto& [scalar, chunk] : row_.fixedBroadcasts)
+  // Values that depend on no coordinate (of constants and parameters only) are the same at every
+  // point: computed once here, not per point, and broadcast where the per-point code reads them.
+  runScalar(program.uniform, scalars.data());
+  for (const auto& [scalar, chunk] : program.fixedBroadcasts)
   {
-    std::fill_n(rowSlots_[chunk], ChunkSize, scalars_[scalar]);
+    std::fill_n(chunks[chunk], ChunkSize, scalars[scalar]);
   }
   rowX_ = { 0, 0, -1, 0 };
+}
+
+template <typename T>
+void BatchEvaluator<T>::preparePoints()
+{
+  // eval()'s program is set up on first use: evalRowX alone (grid sampling, rendering) does not
+  // need it, and for a large tape it is most of the set-up cost. Every axis the tape uses varies.
+  points_ = tape_->rowProgram(tape_->axesUsed());
+  pointStorage_.assign(static_cast<std::size_t>(points_.chunkSlotCount) * ChunkSize, T(0));
+  pointSlots_.resize(points_.chunkSlotCount);
+  for (std::uint32_t i = 0; i < points_.chunkSlotCount; ++i)
+  {
+    pointSlots_[i] = pointStorage_.data() + static_cast<std::size_t>(i) * ChunkSize;
+  }
+  loadValues(points_, pointScalars_, pointSlots_);
+  pointsReady_ = true;
 }
 
 template <typename T>
@@ -306,22 +298,30 @@ void BatchEvaluator<T>::eval(const T* x, const T* y, const T* z, const T* t, T* 
         axisName(static_cast<Axis>(a)) + " but no values were given for it");
     }
   }
-  if (!fullReady_)
+  if (!pointsReady_)
   {
-    prepareFull();
+    preparePoints();
   }
-  const std::uint32_t outSlot = tape_->outputs()[0];
+  const RowProgram::Output& output = points_.outputs[0];
+  if (!output.varying)
+  {
+    std::fill_n(out, n, pointScalars_[output.slot]);
+    return;
+  }
   for (std::size_t start = 0; start < n; start += ChunkSize)
   {
     const std::size_t m = std::min(ChunkSize, n - start);
-    // Inputs are read in place: no instruction writes an input slot. (Writing the output in place
+    // Inputs are read in place: no instruction writes an axis slot. (Writing the output in place
     // as well was measured slower: temporaries sharing its slot then go to the large array.)
     for (int a = 0; a < 4; ++a)
     {
-      slots_[a] = inputs[a] ? const_cast<T*>(inputs[a] + start) : storage_.data() + a * ChunkSize;
+      if (tape_->axesUsed() & (1u << a))
+      {
+        pointSlots_[points_.axisSlots[a]] = const_cast<T*>(inputs[a] + start);
+      }
     }
-    runChunk<T>(tape_->instructions(), slots_.data(), m);
-    std::copy_n(slots_[outSlot], m, out + start);
+    runChunk<T>(points_.varying, pointSlots_.data(), m, pointScalars_.data());
+    std::copy_n(pointSlots_[output.slot], m, out + start);
   }
 }
 
@@ -925,12 +925,19 @@ IncrementalIntervalEvaluator::IncrementalIntervalEvaluator(
     const double v = tape_->constants()[i];
     values_[tape_->constantBase() + i] = { v, v, std::isnan(v) };
   }
+  setParameters(parameters);
+}
+
+void IncrementalIntervalEvaluator::setParameters(const std::vector<double>& parameters)
+{
   std::vector<double> p;
   loadParameters(*tape_, parameters, p);
   for (std::size_t i = 0; i < p.size(); ++i)
   {
     values_[tape_->parameterBase() + i] = { p[i], p[i], std::isnan(p[i]) };
   }
+  // The instructions record the axes they depend on, not the parameters: all run again.
+  first_ = true;
 }
 
 Interval IncrementalIntervalEvaluator::eval(const Region& region)
@@ -968,9 +975,16 @@ IncrementalPointEvaluator::IncrementalPointEvaluator(
 {
   std::copy(
     tape_->constants().begin(), tape_->constants().end(), values_.begin() + tape_->constantBase());
+  setParameters(parameters);
+}
+
+void IncrementalPointEvaluator::setParameters(const std::vector<double>& parameters)
+{
   std::vector<double> p;
   loadParameters(*tape_, parameters, p);
   std::copy(p.begin(), p.end(), values_.begin() + tape_->parameterBase());
+  // As IncrementalIntervalEvaluator::setParameters: everything runs again.
+  first_ = true;
 }
 
 double IncrementalPointEvaluator::eval(double x, double y, double z, double t)

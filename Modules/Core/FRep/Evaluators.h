@@ -57,12 +57,14 @@ public:
   const TapePtr& tape() const { return tape_; }
 
 private:
-  void prepare();
-  void prepareFull();
+  /// Parameters and constants into a program's scalars, its uniform code run, its fixed values
+  /// broadcast into its chunks.
+  void loadValues(
+    const RowProgram& program, std::vector<T>& scalars, const std::vector<T*>& chunks);
+  void preparePoints();
 
   TapePtr tape_;
   std::vector<double> parameters_;
-  bool fullReady_ = false;
   // The x coordinates currently held by the row program's x slot.
   struct RowX
   {
@@ -75,8 +77,13 @@ private:
     }
   };
 
-  std::vector<T> storage_;    // eval(): slotCount chunks
-  std::vector<T*> slots_;     // eval(): where each slot's values are
+  // eval(): the tape split with every axis it uses varying, so that what depends on parameters
+  // and constants only runs once per binding (as JitEvaluator::eval does), not per point.
+  bool pointsReady_ = false;
+  RowProgram points_;
+  std::vector<T> pointStorage_;
+  std::vector<T*> pointSlots_;
+  std::vector<T> pointScalars_;
   RowProgram row_;            // evalRowX(): the tape split along x
   std::vector<T> rowStorage_; // evalRowX(): chunkSlotCount chunks
   std::vector<T*> rowSlots_;  // evalRowX(): where each chunk slot's values are
@@ -125,6 +132,8 @@ class IncrementalIntervalEvaluator
 {
 public:
   explicit IncrementalIntervalEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  /// New parameter values; the next eval runs every instruction.
+  void setParameters(const std::vector<double>& parameters);
   Interval eval(const Region& region);
   const std::vector<Choice>& choices() const { return choices_; }
   TapePtr simplified() const { return tape_->simplify(choices_); }
@@ -144,6 +153,8 @@ class IncrementalPointEvaluator
 {
 public:
   explicit IncrementalPointEvaluator(TapePtr tape, const std::vector<double>& parameters = {});
+  /// New parameter values; the next eval runs every instruction.
+  void setParameters(const std::vector<double>& parameters);
   double eval(double x, double y, double z = 0, double t = 0);
   const TapePtr& tape() const { return tape_; }
 

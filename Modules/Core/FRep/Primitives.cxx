@@ -74,6 +74,17 @@ Expr dot(const EVec& a, const Vec3& b)
   return a.x * b[0] + a.y * b[1] + a.z * b[2];
 }
 
+/// p - c for a point given by expressions (constants fold to fromPoint(Vec3)'s nodes).
+EVec fromPoint(const std::array<Expr, 3>& c)
+{
+  return { Expr::x() - c[0], Expr::y() - c[1], Expr::z() - c[2] };
+}
+
+Expr dot(const EVec& a, const EVec& b)
+{
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
 Expr norm2(const EVec& a)
 {
   return square(a.x) + square(a.y) + square(a.z);
@@ -85,6 +96,12 @@ Expr crossNorm2(const EVec& a, const Vec3& b)
 {
   return square(a.y * b[2] - a.z * b[1]) + square(a.z * b[0] - a.x * b[2]) +
     square(a.x * b[1] - a.y * b[0]);
+}
+
+Expr crossNorm2(const EVec& a, const EVec& b)
+{
+  return square(a.y * b.z - a.z * b.y) + square(a.z * b.x - a.x * b.z) +
+    square(a.x * b.y - a.y * b.x);
 }
 
 /// Sum as a balanced tree, so that a model with thousands of skeletons stays shallow (the
@@ -173,22 +190,14 @@ Expr segmentField(
   requireFinite(primitive, "end of " + what, e);
   requirePositive(primitive, "kernel width s of " + what, s);
   const Vec3 axis = sub(e, b);
-  const double l = std::sqrt(dot(axis, axis));
-  if (!(l > 0))
+  if (!(std::sqrt(dot(axis, axis)) > 0))
   {
     fail(primitive, what + " has zero length (its two ends coincide)");
   }
-  const Vec3 a = scale(axis, 1.0 / l);
-  const double s2 = s * s;
-  const EVec d = fromPoint(b);
-  const Expr x = dot(d, a);
-  const Expr p2 = 1.0 + s2 * crossNorm2(d, a);
-  const Expr p = sqrt(p2);
-  const Expr toBegin = 1.0 + s2 * norm2(d);
-  const Expr toEnd = 1.0 + s2 * norm2(fromPoint(e));
-  const Expr rational = x / (2.0 * p2 * toBegin) + (l - x) / (2.0 * p2 * toEnd);
-  const Expr angular = (atan(s * x / p) + atan(s * (l - x) / p)) / ((2.0 * s) * p2 * p);
-  return rational + angular;
+  // Constant leaves fold every step that depends on no coordinate, in the same double operations
+  // as the evaluators' (so a tape of parameters bound to these values gives the same bits).
+  return cauchySegmentField(
+    { Expr(b[0]), Expr(b[1]), Expr(b[2]) }, { Expr(e[0]), Expr(e[1]), Expr(e[2]) }, Expr(s));
 }
 
 // Arc of radius r, opening theta, in the local frame: centered at the origin in the plane z = 0,
@@ -701,6 +710,25 @@ Expr cauchyPointField(const Vec3& point, double s)
 Expr cauchySegmentField(const Vec3& begin, const Vec3& end, double s)
 {
   return segmentField("cauchySegmentField", "segment", begin, end, s);
+}
+
+Expr cauchySegmentField(
+  const std::array<Expr, 3>& begin, const std::array<Expr, 3>& end, const Expr& s)
+{
+  const EVec axis{ end[0] - begin[0], end[1] - begin[1], end[2] - begin[2] };
+  const Expr l = sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
+  const Expr inverseLength = Expr(1.0) / l;
+  const EVec a{ axis.x * inverseLength, axis.y * inverseLength, axis.z * inverseLength };
+  const Expr s2 = s * s;
+  const EVec d = fromPoint(begin);
+  const Expr x = dot(d, a);
+  const Expr p2 = 1.0 + s2 * crossNorm2(d, a);
+  const Expr p = sqrt(p2);
+  const Expr toBegin = 1.0 + s2 * norm2(d);
+  const Expr toEnd = 1.0 + s2 * norm2(fromPoint(end));
+  const Expr rational = x / (2.0 * p2 * toBegin) + (l - x) / (2.0 * p2 * toEnd);
+  const Expr angular = (atan(s * x / p) + atan(s * (l - x) / p)) / ((2.0 * s) * p2 * p);
+  return rational + angular;
 }
 
 Expr cauchyArcField(

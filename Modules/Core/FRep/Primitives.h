@@ -127,6 +127,13 @@ Shape convolutionMesh(const std::vector<Vec3>& vertices,
 /// (e.g. a HyperFun reader reproducing hfConvArc's 1/radius or hfConvTriangle's s^3 scaling).
 Expr cauchyPointField(const Vec3& point, double s);
 Expr cauchySegmentField(const Vec3& begin, const Vec3& end, double s);
+/// The same with its ends and kernel width as expressions, e.g. Expr::parameter slots: a skeleton
+/// that moves compiles to one tape whose parameters each pose rebinds. Bound to values, such a
+/// tape gives in double precision what the overload above gives with those values as constants,
+/// bit for bit (that one is this one with constant leaves, folded in the same operations). No
+/// checks: the ends must differ and s be positive (the overload above checks them).
+Expr cauchySegmentField(
+  const std::array<Expr, 3>& begin, const std::array<Expr, 3>& end, const Expr& s);
 /// Arc parameters as in convolutionArcs (theta and angle in degrees).
 Expr cauchyArcField(
   const Vec3& center, double radius, double theta, const Vec3& axis, double angle, double s);

@@ -14,6 +14,7 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <string>
 
 namespace ictk::skin
 {
@@ -116,22 +117,76 @@ StandIn initialStandIn(const SkinnedMesh& mesh)
   return out;
 }
 
-frep::Shape standInShape(const StandIn& standIn)
+namespace
 {
-  // Each segment's normalisation from its own small tape (SegmentFields evaluates all of them at
-  // once: n times the work where one is wanted; this runs at every frame of a posed stand-in).
-  frep::Expr sum;
-  for (std::size_t i = 0; i < standIn.segments.size(); ++i)
+
+/// The Cauchy field of a segment whose ends and kernel width are the parameters [a, b, s] from
+/// `slot` on (7 slots), or constants when `g` is given.
+frep::Expr segmentField(const StandInSegment* g, std::uint32_t slot)
+{
+  const auto input = [&](int k, double value)
   {
-    const StandInSegment& g = standIn.segments[i];
-    const frep::Expr field = frep::cauchySegmentField(g.a, g.b, g.s);
-    frep::PointEvaluator own(frep::Tape::compile(field));
-    const Vec3 p =
-      frep::add(frep::lerp(g.a, g.b, 0.5), frep::scale(normalTo(sub(g.b, g.a)), g.radius));
-    const frep::Expr term = frep::Expr(1 / own.eval(p[0], p[1], p[2])) * field;
+    return g ? frep::Expr(value) : frep::Expr::parameter(slot + static_cast<std::uint32_t>(k));
+  };
+  const Vec3 a = g ? g->a : Vec3{ 0, 0, 0 }, b = g ? g->b : Vec3{ 0, 0, 0 };
+  return frep::cauchySegmentField({ input(0, a[0]), input(1, a[1]), input(2, a[2]) },
+    { input(3, b[0]), input(4, b[1]), input(5, b[2]) }, input(6, g ? g->s : 0));
+}
+
+/// 1 / f_i(r_i): the weight that makes a segment alone zero at its radius from its middle. From
+/// one tape of a segment's parameters, compiled once for every stand-in and pose.
+double segmentWeight(const StandInSegment& g)
+{
+  static const frep::TapePtr tape = frep::Tape::compile(segmentField(nullptr, 0));
+  frep::PointEvaluator own(tape, { g.a[0], g.a[1], g.a[2], g.b[0], g.b[1], g.b[2], g.s });
+  const Vec3 p =
+    frep::add(frep::lerp(g.a, g.b, 0.5), frep::scale(normalTo(sub(g.b, g.a)), g.radius));
+  return 1 / own.eval(p[0], p[1], p[2]);
+}
+
+/// F = sum_i w_i f_i - 1 (w_i = segmentWeight), over constants when `standIn` is given, else
+/// over the parameters of n segments (StandInField's layout: a, b, s, w from slot 8 i on).
+frep::Expr standInSum(const StandIn* standIn, std::size_t n)
+{
+  frep::Expr sum;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const StandInSegment* g = standIn ? &standIn->segments[i] : nullptr;
+    const auto slot = static_cast<std::uint32_t>(StandInField::ParametersPerSegment * i);
+    const frep::Expr weight = g ? frep::Expr(segmentWeight(*g)) : frep::Expr::parameter(slot + 7);
+    const frep::Expr term = weight * segmentField(g, slot);
     sum = i == 0 ? term : sum + term;
   }
-  return frep::Shape(sum - frep::Expr(1.0), frep::Domain::XYZ, "standIn");
+  return sum - frep::Expr(1.0);
+}
+
+} // namespace
+
+frep::Shape standInShape(const StandIn& standIn)
+{
+  return frep::Shape(standInSum(&standIn, standIn.segments.size()), frep::Domain::XYZ, "standIn");
+}
+
+StandInField::StandInField(std::size_t segmentCount)
+  : segmentCount_(segmentCount)
+  , tape_(frep::Tape::compile(standInSum(nullptr, segmentCount)))
+{
+}
+
+std::vector<double> StandInField::parameters(const StandIn& standIn) const
+{
+  if (standIn.segments.size() != segmentCount_)
+    throw std::invalid_argument("StandInField: a stand-in of " +
+      std::to_string(standIn.segments.size()) + " segments bound to a tape of " +
+      std::to_string(segmentCount_));
+  std::vector<double> out;
+  out.reserve(ParametersPerSegment * segmentCount_);
+  for (const StandInSegment& g : standIn.segments)
+  {
+    out.insert(out.end(), { g.a[0], g.a[1], g.a[2], g.b[0], g.b[1], g.b[2], g.s });
+    out.push_back(segmentWeight(g));
+  }
+  return out;
 }
 
 frep::Box3 standInBounds(const StandIn& standIn)

@@ -21,6 +21,7 @@
 //   stand-in follows the skeleton exactly (L3266).
 
 #include "FRep/Domain.h"
+#include "FRep/Tape.h"
 #include "Skin/SkinnedMesh.h"
 
 #include <array>
@@ -51,6 +52,28 @@ StandIn initialStandIn(const SkinnedMesh& mesh);
 
 /// The stand-in's field as an FRep shape (domain XYZ), in the frame of its segments' ends.
 frep::Shape standInShape(const StandIn& standIn);
+
+/// The stand-in's field compiled once for a number of segments, each segment's ends, kernel width
+/// and weight 1 / f_i(r_i) being parameters of the tape (ParametersPerSegment a segment: a, b,
+/// s, weight): a stand-in posed or refitted (the same segments, other ends and radii) only binds
+/// its values (parameters()), one tape for every frame as libfive's free variables are. Bound to
+/// a stand-in, the tape gives in double precision what standInShape(that stand-in) compiled
+/// gives, bit for bit: both are one expression, over constants there and parameters here.
+class StandInField
+{
+public:
+  static constexpr std::size_t ParametersPerSegment = 8;
+  explicit StandInField(std::size_t segmentCount);
+  const frep::TapePtr& tape() const { return tape_; }
+  std::size_t segmentCount() const { return segmentCount_; }
+  /// The tape's parameters for `standIn`; throws std::invalid_argument when its number of
+  /// segments is not segmentCount().
+  std::vector<double> parameters(const StandIn& standIn) const;
+
+private:
+  std::size_t segmentCount_ = 0;
+  frep::TapePtr tape_;
+};
 
 /// A box that holds the stand-in's surface: its segments' box grown by twice the largest radius
 /// (a segment alone is zero at its radius; where k segments meet their sum reaches further,
