@@ -437,6 +437,20 @@ TEST(StandIn, InitialApproximationOfATube)
   EXPECT_NEAR(fieldAt(f, { 0, -0.3, 0 }), 0, 1e-12);
   EXPECT_GT(fieldAt(f, { 0.1, 0, 0.5 }), 0);
   EXPECT_LT(fieldAt(f, { 0.5, 0, 0 }), 0);
+  // A pose that breaks a segment is refused, compiled or bound to the one tape, not a NaN field.
+  const StandInField tape(1);
+  for (int broken = 0; broken < 3; ++broken)
+  {
+    StandIn bad = s;
+    if (broken == 0)
+      bad.segments[0].b = bad.segments[0].a;
+    else if (broken == 1)
+      bad.segments[0].a[1] = std::nan("");
+    else
+      bad.segments[0].radius = 0;
+    EXPECT_THROW(standInShape(bad), std::invalid_argument) << broken;
+    EXPECT_THROW(tape.parameters(bad), std::invalid_argument) << broken;
+  }
 }
 
 TEST(StandIn, TheFitRecoversATubesRadius)

@@ -133,6 +133,31 @@ frep::Expr segmentField(const StandInSegment* g, std::uint32_t slot)
     { input(3, b[0]), input(4, b[1]), input(5, b[2]) }, input(6, g ? g->s : 0));
 }
 
+/// Refuses a segment a posed or refitted stand-in cannot be built on (the constant path of
+/// FRep's segment field checked the same; parameters are not checked when they are bound).
+void checkSegment(const StandInSegment& g, std::size_t i)
+{
+  const auto finite = [](const Vec3& v)
+  {
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+  };
+  const std::string which =
+    "stand-in segment " + std::to_string(i) + " (joint " + std::to_string(g.joint) + ")";
+  if (!finite(g.a) || !finite(g.b))
+  {
+    throw std::invalid_argument(which + ": an end is not finite");
+  }
+  if (!(norm(sub(g.b, g.a)) > 0))
+  {
+    throw std::invalid_argument(which + " has zero length (its two ends coincide)");
+  }
+  if (!(g.s > 0) || !std::isfinite(g.s) || !(g.radius > 0) || !std::isfinite(g.radius))
+  {
+    throw std::invalid_argument(
+      which + ": its kernel width and radius must be positive and finite");
+  }
+}
+
 /// 1 / f_i(r_i): the weight that makes a segment alone zero at its radius from its middle. From
 /// one tape of a segment's parameters, compiled once for every stand-in and pose.
 double segmentWeight(const StandInSegment& g)
@@ -152,6 +177,10 @@ frep::Expr standInSum(const StandIn* standIn, std::size_t n)
   for (std::size_t i = 0; i < n; ++i)
   {
     const StandInSegment* g = standIn ? &standIn->segments[i] : nullptr;
+    if (g)
+    {
+      checkSegment(*g, i);
+    }
     const auto slot = static_cast<std::uint32_t>(StandInField::ParametersPerSegment * i);
     const frep::Expr weight = g ? frep::Expr(segmentWeight(*g)) : frep::Expr::parameter(slot + 7);
     const frep::Expr term = weight * segmentField(g, slot);
@@ -181,8 +210,10 @@ std::vector<double> StandInField::parameters(const StandIn& standIn) const
       std::to_string(segmentCount_));
   std::vector<double> out;
   out.reserve(ParametersPerSegment * segmentCount_);
-  for (const StandInSegment& g : standIn.segments)
+  for (std::size_t i = 0; i < segmentCount_; ++i)
   {
+    const StandInSegment& g = standIn.segments[i];
+    checkSegment(g, i);
     out.insert(out.end(), { g.a[0], g.a[1], g.a[2], g.b[0], g.b[1], g.b[2], g.s });
     out.push_back(segmentWeight(g));
   }
