@@ -117,7 +117,7 @@ Drawn FromCanvas(render::Canvas&& c)
   d.Colour = std::move(c.colour);
   d.Depth = std::move(c.depth);
   d.Normal = std::move(c.normal); // empty for VTK's pictures
-  d.Mesh = true; // no interval evaluations to report
+  d.Mesh = true;                  // no interval evaluations to report
   return d;
 }
 
