@@ -277,3 +277,56 @@ TEST(BlobMorph, BundledModelIsTheMorph)
     }
   }
 }
+
+// Item 63's path realised: a cylinder morphs into a box through the segment, the degenerate
+// intermediate at s = 1/2 (the radius shrinks to 0 in the first half, the box's two other sides
+// grow from 0 in the second); both ways.
+TEST(BlobMorph, CylinderToBoxThroughSegment)
+{
+  BlobTree A, B;
+  A.add(Kind::Cylinder, { 1.5, 1, 0, 0, 0, 2, 0, 0, 0.3 });
+  B.add(Kind::Box, { 1.5, 1, 1, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0.5, 0.25, 0 });
+  BlobTree segment;
+  segment.add(Kind::Segment, { 1.5, 1, 0, 0, 0, 2, 0, 0 });
+  for (const bool forward : { true, false })
+  {
+    SCOPED_TRACE(forward ? "cylinder -> box" : "box -> cylinder");
+    const BlobTree C =
+      forward ? morph::morph(A, B, { { 0, 0 } }, S) : morph::morph(B, A, { { 0, 0 } }, S);
+    ASSERT_EQ(C.count(Kind::Box), 1u);
+    const BlobTree start = C.instantiate(0), middle = C.instantiate(0.5), end = C.instantiate(1);
+    // At s = 1/2 the half-sides are (1, 0, 0) and the rounding 0: the segment, exactly.
+    const double* m = middle.values(middle.root());
+    EXPECT_EQ(m[11], 1.0);
+    EXPECT_EQ(m[12], 0.0);
+    EXPECT_EQ(m[13], 0.0);
+    EXPECT_EQ(m[14], 0.0);
+    // One stage at a time: before s = 1/2 only the cylinder's side has moved, after it only the
+    // box's (this S is 0.15625 at t = 0.25 and 0.84375 at t = 0.75).
+    const BlobTree quarter = C.instantiate(forward ? 0.25 : 0.75);
+    const BlobTree threeQuarters = C.instantiate(forward ? 0.75 : 0.25);
+    EXPECT_EQ(quarter.values(0)[12], 0.0);
+    EXPECT_GT(quarter.values(0)[14], 0.0);
+    EXPECT_LT(quarter.values(0)[14], 0.3);
+    EXPECT_EQ(threeQuarters.values(0)[14], 0.0);
+    EXPECT_GT(threeQuarters.values(0)[12], 0.0);
+    EXPECT_LT(threeQuarters.values(0)[12], 0.5);
+    std::mt19937 rng(63);
+    std::uniform_real_distribution<double> x(-1.5, 3.5);
+    for (int k = 0; k < 500; ++k)
+    {
+      const Vec3 p{ x(rng), x(rng) - 1, x(rng) - 1 };
+      ASSERT_NEAR(evaluate(start, p), evaluate(forward ? A : B, p), 1e-12);
+      ASSERT_NEAR(evaluate(middle, p), evaluate(segment, p), 1e-12);
+      ASSERT_NEAR(evaluate(end, p), evaluate(forward ? B : A, p), 1e-12);
+    }
+  }
+  // A point enters the path too (a segment from c to c, then a cylinder of radius 0); a disc
+  // does not.
+  BlobTree point;
+  point.add(Kind::Point, { 1.5, 1, 1, 0, 0 });
+  EXPECT_EQ(morph::morph(point, B, { { 0, 0 } }, S).count(Kind::Box), 1u);
+  BlobTree disc;
+  disc.add(Kind::Disc, { 1.5, 1, 0, 0, 0, 0, 0, 1, 1 });
+  EXPECT_THROW(morph::morph(disc, B, { { 0, 0 } }, S), std::invalid_argument);
+}

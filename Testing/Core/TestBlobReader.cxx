@@ -269,6 +269,72 @@ TEST(BlobReader, AnimatedModelFileAtTime)
     c.eval(1.5, 0, 0), 1 - 22.0 / 9 * q + 17.0 / 9 * q * q - 4.0 / 9 * q * q * q - 0.5, 1e-14);
 }
 
+// Item 1 of docs/blobtree.md's checks: a value valid when read may leave its range at some t. The
+// radius R(t) = 1 - 0.8 t (linear keys from 1 at t = 0 to -0.6 at t = 2) is -0.2 at t = 1.5:
+// instantiation there is refused at the node's keyword, naming the value and t, by the checks of
+// add(); the threshold likewise (wave 0.5 + 0.6 sin(pi t / 2) is -0.1 at t = 3).
+TEST(BlobReader, AnimatedValueOutOfRangeAtTime)
+{
+  const std::string text = "threshold wave(0.5 0.6 4 0)\n"
+                           "blend {\n"
+                           "  point 1 1 [2 0 0]\n"
+                           "  point keys(1, 0 1, 2 -0.6) 1 [0 0 0]\n"
+                           "}\n";
+  lang::BlobOrigins origins;
+  const BlobTree generic = lang::readBlob(text, "m.blob", {}, &origins);
+  ASSERT_EQ(origins.nodes.size(), 1u);
+  ASSERT_TRUE(origins.threshold.has_value());
+  EXPECT_EQ(origins.threshold->where.line, 1);
+  // t = 0 and t = 1 are fine (R = 1, 0.2).
+  EXPECT_DOUBLE_EQ(lang::instantiateBlob(generic, origins, 0.0).values(1)[0], 1.0);
+  EXPECT_NEAR(lang::instantiateBlob(generic, origins, 1.0).values(1)[0], 0.2, 1e-15);
+  try
+  {
+    lang::instantiateBlob(generic, origins, 1.5);
+    ADD_FAILURE() << "a negative radius at t = 1.5 was instantiated";
+  }
+  catch (const lang::ParseError& e)
+  {
+    ASSERT_EQ(e.diagnostics().size(), 1u);
+    const lang::Diagnostic& d = e.diagnostics()[0];
+    EXPECT_EQ(d.where.file, "m.blob");
+    EXPECT_EQ(d.where.line, 4);
+    EXPECT_EQ(d.where.column, 3);
+    EXPECT_EQ(d.message,
+      "blobtree: point: the radius of influence R must be positive (got -0.2) at t = 1.5");
+    EXPECT_EQ(d.sourceLine, "  point keys(1, 0 1, 2 -0.6) 1 [0 0 0]");
+  }
+  // Without origins (a tree built in C++), the InstanceError names the node.
+  try
+  {
+    generic.instantiate(1.5);
+    ADD_FAILURE() << "a negative radius at t = 1.5 was instantiated";
+  }
+  catch (const InstanceError& e)
+  {
+    EXPECT_EQ(e.node(), 1u);
+    EXPECT_EQ(e.time(), 1.5);
+    EXPECT_EQ(std::string(e.what()),
+      "blobtree: point: the radius of influence R must be positive (got -0.2) at t = 1.5 (node 1)");
+  }
+  // A refused instance leaves the one it would have overwritten as it was.
+  BlobTree out = generic.instantiate(1.0);
+  EXPECT_THROW(generic.instantiate(1.5, out), InstanceError);
+  EXPECT_NEAR(out.values(1)[0], 0.2, 1e-15);
+  try
+  {
+    lang::instantiateBlob(generic, origins, 3.0);
+    ADD_FAILURE() << "a negative threshold at t = 3 was instantiated";
+  }
+  catch (const lang::ParseError& e)
+  {
+    EXPECT_EQ(e.diagnostics().at(0).where.line, 1);
+    EXPECT_NE(e.diagnostics()[0].message.find("the threshold T must be positive and finite (got "),
+      std::string::npos);
+    EXPECT_NE(e.diagnostics()[0].message.find(" at t = 3"), std::string::npos);
+  }
+}
+
 // The new nodes in the file form: a surface of revolution and a solid texture read as built in
 // C++.
 TEST(BlobReader, RevolutionAndSolidTexture)

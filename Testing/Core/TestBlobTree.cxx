@@ -966,3 +966,153 @@ TEST(BlobTree, SurfaceWithVariableThickness)
   EXPECT_THROW(bad.add(Kind::ThickSurface, { R, 1, 0, 0, 0, -1, 2, 0, 0, 0, 0, 2, 0, 0 }),
     std::invalid_argument); // negative thickness
 }
+
+// The box element (item 49): d = |max(|q| - h, 0)| - r in its frame, at hand-computed distances;
+// turned by its axes as by a rotate node; its degenerate forms (half-sides (L/2, 0, 0): the
+// cylinder of radius r); the box short-circuit and exact intervals as for every element.
+TEST(BlobTree, BoxElement)
+{
+  const double R = 2;
+  // Centre (1, 2, 3), half-sides (1, 0.5, 0.25), rounding 0.1.
+  const BlobTree box = single(Kind::Box, { R, 1, 1, 2, 3, 1, 0, 0, 0, 1, 0, 1, 0.5, 0.25, 0.1 });
+  EXPECT_DOUBLE_EQ(evaluate(box, { 1.5, 2, 3 }), 1.0);                      // inside
+  EXPECT_NEAR(evaluate(box, { 1, 2, 3.75 }), wyvillByHand(0.4, R), 1e-12);  // over a face
+  EXPECT_NEAR(evaluate(box, { 2.3, 2.9, 3 }), wyvillByHand(0.4, R), 1e-12); // by an edge
+  EXPECT_NEAR(evaluate(box, { 2.3, 2.9, 3.37 }), wyvillByHand(std::sqrt(0.2644) - 0.1, R),
+    1e-12); // by a corner: excess (0.3, 0.4, 0.12)
+  EXPECT_NEAR(fieldAt(box, { 2.3, 2.9, 3.37 }), wyvillByHand(std::sqrt(0.2644) - 0.1, R), 1e-12);
+  // Its axes turn it as a rotate node turns the axis-aligned box: e1 = (1, 1, 0), e2 = (-1, 1, 0)
+  // is the rotation by 45 degrees about z.
+  BlobTree turned;
+  turned.add(Kind::Box, { 1.5, 1, 0, 0, 0, 1, 1, 0, -1, 1, 0, 1, 0.5, 0.25, 0.2 });
+  BlobTree rotated;
+  rotated.add(Kind::Rotate, { 0, 0, 1, M_PI / 4 },
+    { rotated.add(Kind::Box, { 1.5, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0.5, 0.25, 0.2 }) });
+  // A cylinder is the box of half-sides (L/2, 0, 0) and rounding r.
+  const BlobTree cylinder = single(Kind::Cylinder, { 1.5, 1, 0, 0, 0, 2, 0, 0, 0.3 });
+  const BlobTree asBox = single(Kind::Box, { 1.5, 1, 1, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 0.3 });
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> x(-2.5, 3.5);
+  PointEvaluator lowered(Tape::compile(potential(turned)));
+  int nonZero = 0;
+  for (int k = 0; k < 2000; ++k)
+  {
+    const Vec3 p{ x(rng), x(rng), x(rng) };
+    const double f = evaluate(turned, p);
+    nonZero += f != 0;
+    ASSERT_NEAR(f, evaluate(rotated, p), 1e-12);
+    ASSERT_NEAR(lowered.eval(p[0], p[1], p[2]), f, 1e-12);
+    ASSERT_NEAR(evaluate(cylinder, p), evaluate(asBox, p), 1e-12);
+  }
+  EXPECT_GT(nonZero, 200);
+  // The short-circuit: the turned box's extent along x is (1 + 0.5) / sqrt 2 + 0.2 + 1.5.
+  const double reach = 1.5 / std::sqrt(2.0) + 1.7;
+  const auto support = supportBox(turned);
+  EXPECT_NEAR(support[1][0], reach, 1e-12);
+  EXPECT_NEAR(support[0][2], -(0.25 + 1.7), 1e-12);
+  std::size_t kernels = 0;
+  EXPECT_EQ(evaluate(turned, { reach + 0.01, 0, 0 }, &kernels), 0.0);
+  EXPECT_EQ(kernels, 0u);
+  const TapePtr tape = Tape::compile(potential(turned));
+  IntervalEvaluator interval(tape);
+  Region outside;
+  outside.axes = { Interval{ reach + 0.01, reach + 1 }, Interval{ -1, 1 }, Interval{ -1, 1 },
+    Interval{ 0, 0 } };
+  const Interval none = interval.eval(outside);
+  EXPECT_LE(std::fabs(none.lo), 1e-300);
+  EXPECT_LE(std::fabs(none.hi), 1e-300);
+  std::uniform_real_distribution<double> size(0.05, 1.0);
+  for (int r = 0; r < 200; ++r)
+  {
+    Region region;
+    std::array<double, 3> lo{}, w{};
+    for (int k = 0; k < 3; ++k)
+    {
+      lo[k] = x(rng);
+      w[k] = size(rng);
+      region.axes[k] = Interval{ lo[k], lo[k] + w[k] };
+    }
+    region.axes[3] = Interval{ 0, 0 };
+    const Interval bound = interval.eval(region);
+    for (int s = 0; s < 50; ++s)
+    {
+      const double f =
+        lowered.eval(lo[0] + w[0] * std::uniform_real_distribution<double>(0, 1)(rng),
+          lo[1] + w[1] * std::uniform_real_distribution<double>(0, 1)(rng),
+          lo[2] + w[2] * std::uniform_real_distribution<double>(0, 1)(rng));
+      ASSERT_TRUE(bound.contains(f)) << f << " not in [" << bound.lo << ", " << bound.hi << "]";
+    }
+  }
+  BlobTree bad;
+  EXPECT_THROW(bad.add(Kind::Box, { R, 1, 0, 0, 0, 1, 0, 0, 2, 0, 0, 1, 1, 1, 0 }),
+    std::invalid_argument); // parallel axes
+  EXPECT_THROW(bad.add(Kind::Box, { R, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, -1, 1, 0 }),
+    std::invalid_argument); // negative half-side
+  EXPECT_THROW(bad.add(Kind::Box, { R, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 1, -0.1 }),
+    std::invalid_argument); // negative rounding
+}
+
+// Item 49's last simplification (line 140): the two halves of a rectangle in a surface with
+// variable thickness, of one thickness t, are one box of half-sides (a, b, 0) and rounding t,
+// whose field is the two thick triangles' union (max) to 1e-12 everywhere, flat or tilted.
+TEST(BlobTree, ThickRectangleIsOneBox)
+{
+  const double R = 1.2, t = 0.2;
+  // The rectangle a, a + u, a + u + w, a + w: flat, then tilted (u, w orthogonal, inexact).
+  const std::vector<std::array<Vec3, 3>> rectangles = {
+    { Vec3{ 0, 0, 0 }, Vec3{ 2, 0, 0 }, Vec3{ 0, 1, 0 } },
+    { Vec3{ 0.3, -0.2, 0.1 }, Vec3{ 2.0 / 3, 4.0 / 3, 4.0 / 3 },
+      Vec3{ 2.0 / 3, -2.0 / 3, 1.0 / 3 } },
+  };
+  std::mt19937 rng(140);
+  std::uniform_real_distribution<double> x(-1.5, 3);
+  for (const auto& [a, u, w] : rectangles)
+  {
+    const Vec3 b{ a[0] + u[0], a[1] + u[1], a[2] + u[2] };
+    const Vec3 c{ b[0] + w[0], b[1] + w[1], b[2] + w[2] };
+    const Vec3 d{ a[0] + w[0], a[1] + w[1], a[2] + w[2] };
+    BlobTree surface;
+    surface.add(Kind::ThickSurface,
+      { R, 1, a[0], a[1], a[2], t, b[0], b[1], b[2], t, c[0], c[1], c[2], t, a[0], a[1], a[2], t,
+        c[0], c[1], c[2], t, d[0], d[1], d[2], t });
+    const BlobTree expanded = surface.expand();
+    EXPECT_EQ(expanded.count(Kind::Box), 1u);
+    EXPECT_EQ(expanded.count(Kind::ThickTriangle), 0u);
+    EXPECT_EQ(expanded.nodes().size(), 1u);
+    BlobTree prisms;
+    prisms.add(Kind::Max, {},
+      { prisms.add(Kind::ThickTriangle,
+          { R, 1, a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], t, t, t }),
+        prisms.add(Kind::ThickTriangle,
+          { R, 1, a[0], a[1], a[2], c[0], c[1], c[2], d[0], d[1], d[2], t, t, t }) });
+    PointEvaluator lowered(Tape::compile(potential(expanded)));
+    int nonZero = 0;
+    for (int k = 0; k < 3000; ++k)
+    {
+      const Vec3 p{ x(rng), x(rng), x(rng) };
+      const double f = evaluate(prisms, p);
+      nonZero += f != 0;
+      ASSERT_NEAR(evaluate(expanded, p), f, 1e-12);
+      ASSERT_NEAR(lowered.eval(p[0], p[1], p[2]), f, 1e-12);
+    }
+    EXPECT_GT(nonZero, 300);
+  }
+  // Not merged: a parallelogram, unequal thicknesses, or an animated surface.
+  BlobTree parallelogram;
+  parallelogram.add(Kind::ThickSurface,
+    { R, 1, 0, 0, 0, t, 2, 0, 0, t, 3, 1, 0, t, 0, 0, 0, t, 3, 1, 0, t, 1, 1, 0, t });
+  EXPECT_EQ(parallelogram.expand().count(Kind::ThickTriangle), 2u);
+  BlobTree uneven;
+  uneven.add(Kind::ThickSurface,
+    { R, 1, 0, 0, 0, t, 2, 0, 0, t, 2, 1, 0, t, 0, 0, 0, t, 2, 1, 0, t, 0, 1, 0, 0.3 });
+  EXPECT_EQ(uneven.expand().count(Kind::ThickTriangle), 2u);
+  BlobTree animated;
+  const auto s = animated.add(Kind::ThickSurface,
+    { R, 1, 0, 0, 0, t, 2, 0, 0, t, 2, 1, 0, t, 0, 0, 0, t, 2, 1, 0, t, 0, 1, 0, t });
+  Animation wave;
+  wave.base = R;
+  wave.amplitude = 0.1;
+  animated.animate(s, 0, wave);
+  EXPECT_EQ(animated.instantiate(0.3).count(Kind::ThickTriangle), 2u);
+  EXPECT_EQ(animated.instantiate(0.3).count(Kind::Box), 0u);
+}

@@ -26,8 +26,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data), size);
   try
   {
-    const ictk::frep::blob::BlobTree generic = ictk::lang::readBlob(text, "fuzz.blob", limits);
-    const ictk::frep::blob::BlobTree tree = generic.instantiate(0.5);
+    ictk::lang::BlobOrigins origins;
+    const ictk::frep::blob::BlobTree generic =
+      ictk::lang::readBlob(text, "fuzz.blob", limits, &origins);
+    // A value out of its range at t = 0.5 is a ParseError at its node.
+    const ictk::frep::blob::BlobTree tree = ictk::lang::instantiateBlob(generic, origins, 0.5);
     (void)ictk::frep::blob::evaluate(tree, { 0.25, -0.5, 0.75 });
     (void)ictk::frep::blob::supportBox(tree);
     ictk::frep::PointEvaluator evaluator(

@@ -177,6 +177,27 @@ def main():
     for name in ("t1.png", "f00.png", "f01.png"):
         if not os.path.getsize(os.path.join(work, name)):
             sys.exit(f"FAIL: render wrote no {name}")
+    # A value valid when read but out of its range at t: R(t) = 1 - 0.8 t (linear keys) is -0.2 at
+    # t = 1.5. eval and mesh instantiate at t = 0, and refuse t = 1.5 (exit 2, nothing written)
+    # naming the node's line and column, the value and t.
+    shrinking = os.path.join(work, "shrinking.blob")
+    with open(shrinking, "w") as f:
+        f.write("blend {\n  point 1 1 [2 0 0]\n  point keys(1, 0 1, 2 -0.6) 1 [0 0 0]\n}\n")
+    v = json.loads(run(ictk, ["eval", shrinking, "--json", "--at", "0,0,0", "--time", "0"]).stdout)["value"]
+    if abs(v - 0.5) > 1e-12:  # g(0) = 1 at the centre, the other point 2 away with R = 1: 1 - T
+        sys.exit(f"FAIL: shrinking.blob at the origin, t = 0, gives {v}, not 0.5")
+    refused = os.path.join(work, "refused.vtp")
+    for args in (["eval", shrinking, "--at", "0,0,0", "--time", "1.5"],
+                 ["mesh", shrinking, "--time", "1.5", "-o", refused]):
+        p = run(ictk, args, code=2)
+        says = (f"{shrinking}:3:3: error: blobtree: point: the radius of influence R must be "
+                "positive (got -0.2) at t = 1.5")
+        if says not in p.stderr or "point keys(1, 0 1, 2 -0.6)" not in p.stderr:
+            sys.exit(f"FAIL: ictk {' '.join(args)} says:\n{p.stderr}")
+    if os.path.exists(refused):
+        sys.exit("FAIL: the refused mesh was written")
+    run(ictk, ["mesh", shrinking, "--time", "0", "-o", os.path.join(work, "t0.vtp"), "--resolution", "16"])
+
     # Solid textures (docs/blobtree.md) through the attribute machinery: a granite ball, its
     # colour in the sampled volume equal to the noise formula at every grid point, and a marble
     # ball, its colour on the mesh's vertices equal to the vein formula (evaluated just inside).

@@ -408,6 +408,112 @@ std::vector<Animation> promote(std::vector<Animation> v, Kind from, Kind to)
   }
   return v;
 }
+// A point, segment or cylinder (after promote(), a cylinder R i a b r with constant ends) as the
+// rounded box of half-sides (L/2, 0, 0) and rounding r along b - a, its second axis the box's
+// e2 made orthogonal to it (any normal where they are parallel), so that the morph turns no more
+// than it must. The ends must be constant: the box's centre and axis are not animations of them.
+std::vector<Animation> cylinderAsBox(
+  const std::vector<Animation>& v, const std::vector<Animation>& box, double t0)
+{
+  double a[3], b[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    if (!isConstant(v[2 + k]) || !isConstant(v[5 + k]))
+    {
+      throw std::invalid_argument(
+        "morph: a cylinder with animated ends does not morph into a box (item 63's path)");
+    }
+    a[k] = v[2 + k].keys[0][1];
+    b[k] = v[5 + k].keys[0][1];
+  }
+  double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  double l = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  if (l == 0) // a point: the box's own axis
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      e1[k] = box[5 + k].eval(t0);
+    }
+  }
+  const double n1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  double e2[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    e2[k] = box[8 + k].eval(t0);
+  }
+  const double along = (e2[0] * e1[0] + e2[1] * e1[1] + e2[2] * e1[2]) / (n1 * n1);
+  double w2 = 0;
+  for (int k = 0; k < 3; ++k)
+  {
+    e2[k] -= along * e1[k];
+    w2 += e2[k] * e2[k];
+  }
+  if (!(w2 > 1e-24 * n1 * n1))
+  {
+    const int m = std::fabs(e1[0]) <= std::fabs(e1[1]) && std::fabs(e1[0]) <= std::fabs(e1[2])
+      ? 0
+      : (std::fabs(e1[1]) <= std::fabs(e1[2]) ? 1 : 2);
+    double axis[3] = { 0, 0, 0 };
+    axis[m] = 1; // the world axis least along e1: e2 = e1 x axis
+    e2[0] = e1[1] * axis[2] - e1[2] * axis[1];
+    e2[1] = e1[2] * axis[0] - e1[0] * axis[2];
+    e2[2] = e1[0] * axis[1] - e1[1] * axis[0];
+  }
+  std::vector<Animation> out{ v[0], v[1] };
+  for (int k = 0; k < 3; ++k)
+  {
+    out.push_back(constant(0.5 * (a[k] + b[k])));
+  }
+  for (const double x : { e1[0], e1[1], e1[2], e2[0], e2[1], e2[2], 0.5 * l, 0.0, 0.0 })
+  {
+    out.push_back(constant(x));
+  }
+  out.push_back(v[8]); // r
+  return out;
+}
+
+// The two stages of a path through a degenerate intermediate as evolution functions:
+// clamp(2 s, 0, 1) (first) or clamp(2 s - 1, 0, 1), as key-frames at the knots of s on their side
+// of the time where s = 1/2 and there (exact: a span of s cut there is the same polynomial).
+Animation stage(const Animation& s, bool first)
+{
+  double lo = s.keys.front()[0], hi = s.keys.back()[0];
+  for (int k = 0; k < 200 && hi - lo > 0; ++k) // s is increasing from 0 to 1
+  {
+    const double mid = 0.5 * (lo + hi);
+    (s.eval(mid) < 0.5 ? lo : hi) = mid;
+  }
+  const double half = hi;
+  Animation out;
+  out.type = Animation::Type::Keys;
+  out.order = s.order;
+  auto key = [&](double t)
+  {
+    std::vector<double> k{ t, first ? 2 * s.eval(t) : 2 * s.eval(t) - 1 };
+    for (int j = 1; j < s.order; ++j)
+    {
+      k.push_back(2 * s.derivative(t, j));
+    }
+    k[1] = std::min(std::max(k[1], 0.0), 1.0);
+    out.keys.push_back(std::move(k));
+  };
+  if (!first)
+  {
+    key(half);
+  }
+  for (const auto& k : s.keys)
+  {
+    if (first ? k[0] < half : k[0] > half)
+    {
+      key(k[0]);
+    }
+  }
+  if (first)
+  {
+    key(half);
+  }
+  return out;
+}
 } // namespace
 
 SplitTrees splitCorrespondences(
@@ -505,6 +611,34 @@ BlobTree morph(
     }
     std::vector<Animation> va = valuesOf(a, i), vb = valuesOf(b, i);
     Kind kind = na.kind;
+    const bool toBox = na.kind != nb.kind && !na.childCount &&
+      (na.kind == Kind::Box || nb.kind == Kind::Box) &&
+      generality(na.kind == Kind::Box ? nb.kind : na.kind) >= 0 &&
+      generality(na.kind == Kind::Box ? nb.kind : na.kind) <= 2;
+    if (toBox)
+    {
+      // Item 63's path cylinder -> segment -> box (a point or segment enters it on the way): the
+      // cylinder as the box of half-sides (L/2, 0, 0) rounded by r; the geometry (centre, axes,
+      // first half-side) moves with s throughout, the rounding and the two other half-sides in
+      // two stages, so that at s = 1/2 the element is the degenerate intermediate, a segment
+      // (for a sharp box). The cylinder's side shrinks first, the box's side grows second.
+      const bool boxIsB = nb.kind == Kind::Box;
+      const Kind other = boxIsB ? na.kind : nb.kind;
+      std::vector<Animation>& cyl = boxIsB ? va : vb;
+      cyl = cylinderAsBox(promote(cyl, other, Kind::Cylinder), boxIsB ? vb : va, s.keys[0][0]);
+      const Animation first = stage(s, true), second = stage(s, false);
+      std::vector<Animation> values;
+      for (std::size_t k = 0; k < va.size(); ++k)
+      {
+        const bool rounding = k == 14, sides = k == 12 || k == 13;
+        const Animation& e = !(rounding || sides) ? s : ((rounding == boxIsB) ? first : second);
+        const bool same =
+          isConstant(va[k]) && isConstant(vb[k]) && va[k].keys[0][1] == vb[k].keys[0][1];
+        values.push_back(same ? va[k] : mergeKeyframes(va[k], vb[k], e));
+      }
+      map[i] = addAnimated(c, Kind::Box, values, children);
+      continue;
+    }
     if (na.kind != nb.kind && !na.childCount)
     {
       // Skeletal elements of two kinds meet in the more general one (item 63's chain).
@@ -512,7 +646,8 @@ BlobTree morph(
       {
         throw std::invalid_argument(std::string("morph: no interpolation from ") +
           kindName(na.kind) + " to " + kindName(nb.kind) +
-          " (skeletal elements morph along point -> segment -> cylinder -> conesphere)");
+          " (skeletal elements morph along point -> segment -> cylinder -> conesphere, and "
+          "from a point, segment or cylinder into a box)");
       }
       kind = generality(na.kind) > generality(nb.kind) ? na.kind : nb.kind;
       va = promote(va, na.kind, kind);

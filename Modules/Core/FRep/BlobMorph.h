@@ -86,7 +86,10 @@ SplitTrees splitCorrespondences(
 /// trees' structure, every value of a pair interpolated by mergeKeyframes, the threshold too.
 /// Skeletal elements of different kinds meet in the more general kind of the chain
 /// point -> segment -> cylinder -> cone-sphere (each degenerates into the one before; the path
-/// of the standard InterpolationGraph); other kinds throw. Texture nodes of one type interpolate
+/// of the standard InterpolationGraph); a point, segment or cylinder (constant ends) and a box
+/// take the path cylinder -> segment -> box, the cylinder's rounding shrinking while s < 1/2 and
+/// the box's two other half-sides growing after, so that the element is a segment at s = 1/2;
+/// other kinds throw. Texture nodes of one type interpolate
 /// their parameters (item 64); of different types, their subtree is cross-dissolved (item 65):
 /// a blend of the two textured copies with intensities scaled by 1 - s and s, so that
 /// Phi_C = (1 - s) Phi_A + s Phi_B and f_C is the morphed field (line 352), exactly at the knots

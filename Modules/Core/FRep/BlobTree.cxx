@@ -208,6 +208,31 @@ S thickTriangleDistance(const P<S>& p, const double* v)
   return select(inside, h - thickness, edges);
 }
 
+// The box's orthonormal frame: e1 normalised, e2 made orthogonal to it, e3 = e1 x e2.
+std::array<Vec3, 3> boxFrame(const double* e1, const double* e2)
+{
+  const Vec3 u = vscale(vec(e1), 1.0 / std::sqrt(vdot(vec(e1), vec(e1))));
+  const Vec3 w = vsub(e2, vscale(u, vdot(vec(e2), u)).data());
+  const Vec3 v = vscale(w, 1.0 / std::sqrt(vdot(w, w)));
+  return { u, v, vcross(u, v) };
+}
+
+// The rounded box (c e1 e2 a b c r): outside the box its distance from the point's excess over
+// the half-sides in the box's frame, minus the rounding r; 0 inside.
+template <class S>
+S boxDistance2(const P<S>& p, const double* v)
+{
+  const std::array<Vec3, 3> e = boxFrame(v + 3, v + 6);
+  const P<S> pc = minus(p, v);
+  S d2(0.0);
+  for (int k = 0; k < 3; ++k)
+  {
+    const S q = max(abs(dot(pc, e[k])) - v[9 + k], S(0.0));
+    d2 = k == 0 ? square(q) : d2 + square(q);
+  }
+  return v[12] == 0 ? d2 : square(max(sqrt(d2) - v[12], S(0.0)));
+}
+
 // Squared distance of an element's skeleton (the values after R and i).
 template <class S>
 S skeletonDistance2(Kind kind, const double* v, std::uint32_t count, const P<S>& p)
@@ -240,6 +265,8 @@ S skeletonDistance2(Kind kind, const double* v, std::uint32_t count, const P<S>&
       return square(max(coneSphereDistance(p, v, v + 3, v[6], v[7]), S(0.0)));
     case Kind::ThickTriangle:
       return square(max(thickTriangleDistance(p, v), S(0.0)));
+    case Kind::Box:
+      return boxDistance2(p, v);
     case Kind::HollowCone:
     {
       // The 2D cone-sphere in the meridian half-plane (rho, h) of the point.
@@ -318,6 +345,19 @@ Box elementBox(Kind kind, const double* values, std::uint32_t count)
         grow(b, vec(v + 3 * k), std::max({ v[9], v[10], v[11] }) + R);
       }
       break;
+    case Kind::Box:
+    {
+      // The rounded box's half-extent along axis k: sum_j h_j |e_j[k]| + r.
+      const std::array<Vec3, 3> e = boxFrame(v + 3, v + 6);
+      for (int k = 0; k < 3; ++k)
+      {
+        const double half = v[9] * std::fabs(e[0][k]) + v[10] * std::fabs(e[1][k]) +
+          v[11] * std::fabs(e[2][k]) + v[12] + R;
+        b[0][k] = v[k] - half;
+        b[1][k] = v[k] + half;
+      }
+      break;
+    }
     case Kind::HollowCone:
     {
       // The cylinder about the axis that holds the revolved profile: its ends' discs of radius r
@@ -635,6 +675,7 @@ const Rule& rule(Kind kind)
     { "conesphere", 10, 0, 0, 0, 0 },
     { "hollowcone", 14, 0, 0, 0, 0 },
     { "thicktriangle", 14, 0, 0, 0, 0 },
+    { "box", 15, 0, 0, 0, 0 },
     { "gcylinder", 3, 4, 2, 0, 0 },
     { "revolution", 9, 3, 2, 0, 0 },
     { "thicksurface", 2, 12, 1, 0, 0 },
@@ -685,9 +726,17 @@ void requireNonNegative(Kind kind, const char* name, double v)
   }
 }
 
-// The geometric checks beyond counts and finiteness.
+// The checks of a node's values beyond their count: finite, then the geometric rules. add()
+// applies them to the values as given, instantiate() to the animated nodes' values at t.
 void checkValues(Kind kind, const double* v, std::uint32_t count)
 {
+  for (std::uint32_t k = 0; k < count; ++k)
+  {
+    if (!std::isfinite(v[k]))
+    {
+      fail(kind, "every value must be finite (got " + show(v[k]) + ")");
+    }
+  }
   if (isSkeletal(kind) || isComplexPrimitive(kind))
   {
     requirePositive(kind, "the radius of influence R", v[0]);
@@ -759,6 +808,17 @@ void checkValues(Kind kind, const double* v, std::uint32_t count)
           requireNonNegative(kind, "every thickness", tri[q]);
         }
       }
+      break;
+    case Kind::Box:
+      if (!(vdot(vcross(vec(s + 3), vec(s + 6)), vcross(vec(s + 3), vec(s + 6))) > 0))
+      {
+        fail(kind, "the axes e1 and e2 must be non-zero and not parallel");
+      }
+      for (int k = 9; k < 12; ++k)
+      {
+        requireNonNegative(kind, "every half-side", s[k]);
+      }
+      requireNonNegative(kind, "the rounding r", s[12]);
       break;
     case Kind::HollowCone:
       if (vdot(vec(s + 3), vec(s + 3)) == 0)
@@ -842,7 +902,7 @@ const char* kindName(Kind kind)
 }
 bool isSkeletal(Kind kind)
 {
-  return kind <= Kind::ThickTriangle;
+  return kind <= Kind::Box;
 }
 bool isComplexPrimitive(Kind kind)
 {
@@ -894,13 +954,6 @@ std::uint32_t BlobTree::add(
       "expects " + std::to_string(r.values) + " values then at least " +
         std::to_string(r.minItems) + " groups of " + std::to_string(r.item) + " (got " +
         std::to_string(count) + " values)");
-  }
-  for (double v : values)
-  {
-    if (!std::isfinite(v))
-    {
-      fail(kind, "every value must be finite (got " + show(v) + ")");
-    }
   }
   checkValues(kind, values.data(), count);
   const auto k = static_cast<std::uint32_t>(children.size());
@@ -1003,6 +1056,41 @@ void BlobTree::animate(std::uint32_t node, std::uint32_t index, Animation animat
     }
   }
   animations_.push_back({ nodes_[node].firstValue + index, std::move(animation) });
+  if (std::find(animatedNodes_.begin(), animatedNodes_.end(), node) == animatedNodes_.end())
+  {
+    animatedNodes_.push_back(node);
+  }
+}
+
+InstanceError::InstanceError(std::uint32_t node, double time, const std::string& reason)
+  : std::invalid_argument(reason + " at t = " + show(time) +
+      (node == Threshold ? std::string() : " (node " + std::to_string(node) + ")"))
+  , node_(node)
+  , time_(time)
+  , reason_(reason)
+{
+}
+
+void BlobTree::checkAt(double t, const double* values, double threshold) const
+{
+  // Only animated values change with t; the others passed add()'s checks.
+  if (!(threshold > 0) || !std::isfinite(threshold))
+  {
+    throw InstanceError(InstanceError::Threshold, t,
+      "blobtree: the threshold T must be positive and finite (got " + show(threshold) + ")");
+  }
+  for (const std::uint32_t i : animatedNodes_)
+  {
+    const Node& n = nodes_[i];
+    try
+    {
+      checkValues(n.kind, values + n.firstValue, n.valueCount);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      throw InstanceError(i, t, e.what());
+    }
+  }
 }
 
 const Animation* BlobTree::animation(std::uint32_t node, std::uint32_t index) const
@@ -1038,6 +1126,7 @@ void BlobTree::clear()
   parented_.clear();
   animations_.clear();
   thresholdAnimation_.clear();
+  animatedNodes_.clear();
   pieces_.clear();
   root_ = 0;
   touch();

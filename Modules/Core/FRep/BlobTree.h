@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,13 @@ enum class Kind : std::uint8_t
   /// planes through v +- t n; its sides are rounded (the paper's polyhedron has flat sides), so
   /// that neighbouring triangles of a surface meet without cracks. Null thickness: the triangle.
   ThickTriangle,
+  /// R i | c e1 e2 a b c r: a rounded box, the points within r (>= 0) of the box of half-sides
+  /// (a, b, c) (>= 0) about the centre c in the frame of the axes e1, e2 (e2 made orthogonal to
+  /// e1, the third axis e1 x e2): d = |max(|q| - h, 0)| - r with q the point in that frame. With r
+  /// = 0 the paper's box (item 49); half-sides (a, b, 0) and r = t are the two halves of a thick
+  /// rectangle (two ThickTriangles of equal thickness t) merged, half-sides (a, 0, 0) a cylinder
+  /// of radius r (a segment for r = 0), the degenerate forms of the morph's path (item 63).
+  Box,
   // --- complex skeletal primitive (expanded into leaves by expand(), papers.md 3.4)
   // ---
   GeneralisedCylinder, ///< R i n | (v r)...  (control points with radii, >= 2; n >= 1 segments)
@@ -84,7 +92,9 @@ enum class Kind : std::uint8_t
   SurfaceOfRevolution,
   /// R i | (a ta b tb c tc)...: a surface with variable thickness (papers.md 3.4, lines 127-140),
   /// a triangle mesh given triangle by triangle, each vertex with its thickness: one ThickTriangle
-  /// per triangle (a Triangle where all three thicknesses are null), joined by max nodes.
+  /// per triangle (a Triangle where all three thicknesses are null), joined by max nodes; two
+  /// successive triangles that are the halves of a rectangle with one thickness t at their six
+  /// vertices are one Box (half-sides (a, b, 0), r = t; line 140), unless the surface is animated.
   ThickSurface,
   // --- operators ---
   Blend,        ///< sum of >= 1 children (papers.md 3.3, line 66)
@@ -155,6 +165,28 @@ struct Animation
   double derivative(double t, int j) const;
 };
 
+/// A value of an animated tree out of its range at a time t: instantiate(t) applies add()'s
+/// checks to the values at t of the nodes with an animated value (and to the threshold), since a
+/// wave or key-frames may drive a radius below 0 at some t. what() is the reason, t and the node.
+class InstanceError : public std::invalid_argument
+{
+public:
+  /// node() for the threshold.
+  static constexpr std::uint32_t Threshold = 0xffffffffu;
+  InstanceError(std::uint32_t node, double time, const std::string& reason);
+  /// The node of the generic tree (its index in nodes()), or Threshold.
+  std::uint32_t node() const { return node_; }
+  double time() const { return time_; }
+  /// add()'s message for the value, e.g. "blobtree: point: the radius of influence R must be
+  /// positive (got -0.25)".
+  const std::string& reason() const { return reason_; }
+
+private:
+  std::uint32_t node_;
+  double time_;
+  std::string reason_;
+};
+
 class BlobTree
 {
 public:
@@ -203,7 +235,8 @@ public:
   /// The static tree at time t (papers.md 3.6, lines 227-229): every animated value evaluated,
   /// complex primitives expanded into skeletal elements (expand()). `out` (not this tree) is
   /// overwritten; when it already holds an instance of this structure only its values are
-  /// rewritten, so instantiating many times allocates nothing.
+  /// rewritten, so instantiating many times allocates nothing. Throws InstanceError, leaving
+  /// `out` unchanged, where an animated value at t fails the checks of add().
   void instantiate(double t, BlobTree& out) const;
   BlobTree instantiate(double t) const;
   /// The same tree with complex primitives expanded (a static tree: animations are dropped).
@@ -214,6 +247,8 @@ public:
 
 private:
   void touch(); // the structure changed
+  // add()'s checks on the animated nodes' values at t (values: all of the tree's, at t).
+  void checkAt(double t, const double* values, double threshold) const;
   double threshold_;
   std::uint32_t root_ = 0;
   std::vector<Node> nodes_;
@@ -226,6 +261,7 @@ private:
   };
   std::vector<Animated> animations_;
   std::vector<Animation> thresholdAnimation_; // empty or one
+  std::vector<std::uint32_t> animatedNodes_;  // the nodes with an animated value, once each
   std::vector<bool> parented_;                // add(): which nodes already have a parent
   std::vector<double> scratch_;               // instantiate(): the values at t
   std::vector<std::uint32_t> map_;            // instantiate(): node of the source -> node here

@@ -216,6 +216,89 @@ Kind revolutionPiece(const double* nv, const std::array<double, 4>& a,
   count = 14;
   return Kind::HollowCone;
 }
+// Two triangles of a surface with variable thickness (a ta b tb c tc each) that are the halves
+// of a rectangle, with one thickness t at their six vertices: their union, the rectangle swept by
+// a sphere of radius t (ThickTriangle's rounded sides), is the rounded box of half-sides
+// (a, b, 0) and rounding t, written into `box` (c e1 e2 a b c r). They share a diagonal (two
+// vertices, bit for bit) and their other vertices p, q make a parallelogram with it (p + q =
+// s0 + s1) with equal diagonals: a rectangle, to 1e-12 of the diagonal's length.
+bool rectangleBox(const double* one, const double* two, double* box)
+{
+  const double t = one[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    if (one[4 * k + 3] != t || two[4 * k + 3] != t)
+    {
+      return false;
+    }
+  }
+  const auto same = [](const double* a, const double* b)
+  {
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+  };
+  const double* shared[2] = { nullptr, nullptr };
+  const double* p = nullptr;
+  int found = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    bool inTwo = false;
+    for (int b = 0; b < 3; ++b)
+    {
+      inTwo = inTwo || same(one + 4 * a, two + 4 * b);
+    }
+    if (inTwo && found < 2)
+    {
+      shared[found++] = one + 4 * a;
+    }
+    else if (!inTwo)
+    {
+      p = one + 4 * a;
+    }
+  }
+  if (found != 2 || !p)
+  {
+    return false;
+  }
+  const double* q = nullptr;
+  for (int b = 0; b < 3; ++b)
+  {
+    if (!same(two + 4 * b, shared[0]) && !same(two + 4 * b, shared[1]))
+    {
+      q = two + 4 * b;
+    }
+  }
+  if (!q)
+  {
+    return false;
+  }
+  double diagonal = 0, other = 0, gap = 0;
+  for (int k = 0; k < 3; ++k)
+  {
+    diagonal += (shared[1][k] - shared[0][k]) * (shared[1][k] - shared[0][k]);
+    other += (q[k] - p[k]) * (q[k] - p[k]);
+    const double g = p[k] + q[k] - shared[0][k] - shared[1][k];
+    gap += g * g;
+  }
+  if (!(gap <= 1e-24 * diagonal) || !(std::fabs(other - diagonal) <= 1e-12 * diagonal))
+  {
+    return false;
+  }
+  // The sides from p: u = s0 - p, w = s1 - p; the centre the diagonal's midpoint.
+  double u2 = 0, w2 = 0;
+  for (int k = 0; k < 3; ++k)
+  {
+    box[k] = 0.5 * (shared[0][k] + shared[1][k]);
+    box[3 + k] = shared[0][k] - p[k];
+    box[6 + k] = shared[1][k] - p[k];
+    u2 += box[3 + k] * box[3 + k];
+    w2 += box[6 + k] * box[6 + k];
+  }
+  box[9] = 0.5 * std::sqrt(u2);
+  box[10] = 0.5 * std::sqrt(w2);
+  box[11] = 0;
+  box[12] = t;
+  return true;
+}
 } // namespace
 
 void BlobTree::touch()
@@ -251,12 +334,18 @@ std::uint32_t joinUnderMax(
 
 void BlobTree::instantiate(double t, BlobTree& out) const
 {
-  double threshold = threshold_;
-  if (!thresholdAnimation_.empty())
+  // The values at t (parameters P_A(t)), checked as add() checks values (a wave or key-frames
+  // may leave a value's range at some t), before `out` changes: a refused instance leaves it as
+  // it was. Then the nodes in order, complex ones expanded.
+  const double threshold =
+    thresholdAnimation_.empty() ? threshold_ : thresholdAnimation_[0].eval(t);
+  std::vector<double>& v = out.scratch_;
+  v.assign(values_.begin(), values_.end());
+  for (const Animated& a : animations_)
   {
-    const double T = thresholdAnimation_[0].eval(t);
-    threshold = T > 0 && std::isfinite(T) ? T : threshold_;
+    v[a.value] = a.animation.eval(t);
   }
+  checkAt(t, v.data(), threshold);
   // The instance keeps its layout when it was made from this structure: only values change.
   const bool relayout = out.instanceOf_ == 0 || out.instanceOf_ != structure_;
   if (relayout)
@@ -267,13 +356,6 @@ void BlobTree::instantiate(double t, BlobTree& out) const
   if (nodes_.empty())
   {
     return;
-  }
-  // The values at t (parameters P_A(t)), then the nodes in order, complex ones expanded.
-  std::vector<double>& v = out.scratch_;
-  v.assign(values_.begin(), values_.end());
-  for (const Animated& a : animations_)
-  {
-    v[a.value] = a.animation.eval(t);
   }
   std::vector<std::uint32_t>& map = out.map_;
   if (relayout)
@@ -321,19 +403,30 @@ void BlobTree::instantiate(double t, BlobTree& out) const
     if (n.kind == Kind::ThickSurface)
     {
       // Surface with variable thickness (lines 127-140): a thick triangle per triangle, a plain
-      // triangle where its three thicknesses are null (line 139), in slots of 14 values.
+      // triangle where its three thicknesses are null (line 139), in slots of 15 values. Two
+      // successive triangles that make a rectangle of one thickness are one box (line 140); the
+      // pairs are found only in a static surface, so that every instance has the layout of the
+      // first.
+      const bool merge =
+        std::find(animatedNodes_.begin(), animatedNodes_.end(), i) == animatedNodes_.end();
       level.clear();
       for (std::uint32_t k = 2; k + 12 <= n.valueCount; k += 12)
       {
         const double* tri = nv + k;
+        double pieceValues[15] = { nv[0], nv[1], tri[0], tri[1], tri[2], tri[4], tri[5], tri[6],
+          tri[8], tri[9], tri[10], tri[3], tri[7], tri[11], 0 };
         const bool thin = tri[3] == 0 && tri[7] == 0 && tri[11] == 0;
-        const double pieceValues[14] = { nv[0], nv[1], tri[0], tri[1], tri[2], tri[4], tri[5],
-          tri[6], tri[8], tri[9], tri[10], tri[3], tri[7], tri[11] };
-        const Kind kind = thin ? Kind::Triangle : Kind::ThickTriangle;
-        const std::uint32_t count = thin ? 11 : 14;
+        Kind kind = thin ? Kind::Triangle : Kind::ThickTriangle;
+        std::uint32_t count = thin ? 11 : 14;
+        if (merge && k + 24 <= n.valueCount && rectangleBox(tri, tri + 12, pieceValues + 2))
+        {
+          kind = Kind::Box;
+          count = 15;
+          k += 12;
+        }
         if (relayout)
         {
-          level.push_back(push(kind, pieceValues, count, 14, nullptr, 0));
+          level.push_back(push(kind, pieceValues, count, 15, nullptr, 0));
           out.pieces_.push_back(level.back());
         }
         else
@@ -341,7 +434,7 @@ void BlobTree::instantiate(double t, BlobTree& out) const
           Node& leaf = out.nodes_[out.pieces_[piece++]];
           leaf.kind = kind;
           leaf.valueCount = count;
-          std::copy(pieceValues, pieceValues + 14, out.values_.data() + leaf.firstValue);
+          std::copy(pieceValues, pieceValues + 15, out.values_.data() + leaf.firstValue);
         }
       }
       if (relayout)

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
@@ -47,10 +48,12 @@ struct Value
 class Parser
 {
 public:
-  Parser(const std::string& text, const std::string& file, const Limits& limits)
+  Parser(
+    const std::string& text, const std::string& file, const Limits& limits, BlobOrigins* origins)
     : text_(text)
     , file_(file)
     , limits_(limits)
+    , origins_(origins)
   {
     advance();
   }
@@ -70,6 +73,10 @@ public:
           try
           {
             tree_.animateThreshold(*v.animation);
+            if (origins_)
+            {
+              origins_->threshold = origin(at);
+            }
           }
           catch (const std::invalid_argument& e)
           {
@@ -124,6 +131,14 @@ private:
     }
     const std::size_t end = text_.find('\n', start);
     return text_.substr(start, end == std::string::npos ? std::string::npos : end - start);
+  }
+
+  Diagnostic origin(const Token& at) const
+  {
+    Diagnostic d;
+    d.where = SourceLocation{ file_, at.line, at.column };
+    d.sourceLine = lineText(at.line);
+    return d;
   }
 
   void report(const Token& at, const std::string& message)
@@ -506,6 +521,10 @@ private:
         }
         tree_.animate(index, slot, std::move(animation));
       }
+      if (origins_ && !animations.empty())
+      {
+        origins_->nodes[index] = origin(at);
+      }
       return index;
     }
     catch (const std::invalid_argument& e)
@@ -518,6 +537,7 @@ private:
   const std::string& text_;
   std::string file_;
   Limits limits_;
+  BlobOrigins* origins_;
   std::size_t pos_ = 0, lineStart_ = 0;
   int line_ = 1;
   Token current_;
@@ -530,8 +550,12 @@ private:
 } // namespace
 
 frep::blob::BlobTree readBlob(
-  const std::string& text, const std::string& fileName, const Limits& limits)
+  const std::string& text, const std::string& fileName, const Limits& limits, BlobOrigins* origins)
 {
+  if (origins)
+  {
+    *origins = {};
+  }
   if (text.size() > limits.maxFileBytes)
   {
     Diagnostic d;
@@ -540,12 +564,44 @@ frep::blob::BlobTree readBlob(
       std::to_string(limits.maxFileBytes);
     throw ParseError({ d });
   }
-  return Parser(text, fileName, limits).parse();
+  return Parser(text, fileName, limits, origins).parse();
 }
 
-frep::blob::BlobTree readBlobFile(const std::string& path, const Limits& limits)
+frep::blob::BlobTree readBlobFile(
+  const std::string& path, const Limits& limits, BlobOrigins* origins)
 {
-  return readBlob(readSourceFile(path, limits), path, limits);
+  return readBlob(readSourceFile(path, limits), path, limits, origins);
+}
+
+frep::blob::BlobTree instantiateBlob(
+  const frep::blob::BlobTree& tree, const BlobOrigins& origins, double t)
+{
+  try
+  {
+    return tree.instantiate(t);
+  }
+  catch (const frep::blob::InstanceError& e)
+  {
+    const Diagnostic* at = nullptr;
+    if (e.node() == frep::blob::InstanceError::Threshold)
+    {
+      at = origins.threshold ? &*origins.threshold : nullptr;
+    }
+    else if (const auto found = origins.nodes.find(e.node()); found != origins.nodes.end())
+    {
+      at = &found->second;
+    }
+    if (!at)
+    {
+      throw;
+    }
+    Diagnostic d = *at;
+    std::ostringstream time;
+    time.precision(12);
+    time << e.time();
+    d.message = e.reason() + " at t = " + time.str();
+    throw ParseError({ d });
+  }
 }
 
 namespace

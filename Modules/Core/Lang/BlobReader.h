@@ -19,17 +19,37 @@
 #include "FRep/BlobTree.h"
 #include "Lang/Diagnostics.h"
 
+#include <map>
+#include <optional>
 #include <string>
 
 namespace ictk::lang
 {
 
+/// Where the animated values of a tree read from text were written: the keyword of each node
+/// with an animated value (by its index in the tree) and the threshold keyword, as diagnostics
+/// without a message. Only these can be refused after reading, at a time t.
+struct BlobOrigins
+{
+  std::map<std::uint32_t, Diagnostic> nodes;
+  std::optional<Diagnostic> threshold;
+};
+
 /// Parses .blob text; `fileName` names the source in diagnostics. Throws ParseError with the
-/// errors found (file:line:col), each at the offending token or node keyword.
-frep::blob::BlobTree readBlob(
-  const std::string& text, const std::string& fileName = {}, const Limits& limits = {});
+/// errors found (file:line:col), each at the offending token or node keyword. `origins`, when
+/// given, receives where the animated values were written (for instantiateBlob).
+frep::blob::BlobTree readBlob(const std::string& text, const std::string& fileName = {},
+  const Limits& limits = {}, BlobOrigins* origins = nullptr);
 /// Reads and parses a file. Throws ParseError (also for an unreadable or too large file).
-frep::blob::BlobTree readBlobFile(const std::string& path, const Limits& limits = {});
+frep::blob::BlobTree readBlobFile(
+  const std::string& path, const Limits& limits = {}, BlobOrigins* origins = nullptr);
+
+/// The instance of a tree read from text at time t (BlobTree::instantiate). A value out of its
+/// range at t (frep::blob::InstanceError, e.g. a radius a wave drives below 0) is thrown as a
+/// ParseError at the node's keyword, naming the value and t; a node without an origin rethrows
+/// the InstanceError.
+frep::blob::BlobTree instantiateBlob(
+  const frep::blob::BlobTree& tree, const BlobOrigins& origins, double t);
 
 /// The .blob text of a generic tree: the threshold, then the nodes reachable from the root, one
 /// a line, indented by depth, with their animations as wave(...) and keys(...) and their angles

@@ -189,14 +189,17 @@ bool isBlobFile(const std::string& path)
 
 BlobModelFile loadBlobModelFile(const std::string& path, const Limits& limits)
 {
-  return BlobModelFile{ std::filesystem::path(path).stem().string(), readBlobFile(path, limits) };
+  BlobModelFile blob;
+  blob.name = std::filesystem::path(path).stem().string();
+  blob.tree = readBlobFile(path, limits, &blob.origins);
+  return blob;
 }
 
 ModelFile BlobModelFile::at(double t) const
 {
   // The tree's field mapped to f >= 0 inside (frep::blob::shape); the bounds are the instance's
   // support box, where every element's field vanishes, with a 2 % margin.
-  const frep::blob::BlobTree instance = tree.instantiate(t);
+  const frep::blob::BlobTree instance = this->instance(t);
   const auto box = frep::blob::supportBox(instance);
   std::array<double, 6> bounds{};
   for (int a = 0; a < 3; ++a)
@@ -333,7 +336,7 @@ void saveBlobFile(const BlobModelFile& blob, const std::string& path, std::optio
   {
     throw std::invalid_argument("cannot save '" + path + "': the time is not a finite number");
   }
-  writeAtomically(path, writeBlob(time ? blob.tree.instantiate(*time) : blob.tree));
+  writeAtomically(path, writeBlob(time ? blob.instance(*time) : blob.tree));
 }
 
 void saveModelFile(const ModelFile& model, const std::string& path)

@@ -7,6 +7,7 @@
 
 #include "FRep/BlobTree.h"
 #include "FRep/Hypervolume.h"
+#include "Lang/BlobReader.h"
 #include "Lang/Diagnostics.h"
 
 #include <array>
@@ -33,7 +34,11 @@ struct BlobModelFile
 {
   std::string name;
   frep::blob::BlobTree tree; ///< the generic tree, as read
+  BlobOrigins origins;       ///< where its animated values were written
   bool animated() const { return tree.animated(); }
+  /// The instance at time t (lang::instantiateBlob): throws ParseError at the node whose value
+  /// is out of its range at t.
+  frep::blob::BlobTree instance(double t) const { return instantiateBlob(tree, origins, t); }
   /// The model at time t: the instance's shape (potential - T; with its materials as the
   /// attributes "colour" and "optics" when the tree has material nodes) and its support box at t
   /// with a 2 % margin as the bounds.
