@@ -1046,6 +1046,52 @@ def check_run_standin(ictk, work, data):
             sys.exit(f"FAIL: frame {k}: Andy's x range {b[0]}..{b[1]}")
 
 
+def check_run_characters(ictk, work, data):
+    """ictk run on thesis 5.5 between two characters of assimp-testmodels (metamorphosis_characters
+    .icm): the humanoid BCN_Epileptic becomes the quadruped Testwuson. The instances come in order,
+    K2 -> K3 switches when every vertex of the humanoid is within 1e-6 of its stand-in and every
+    normal within a degree (before alpha reaches 1 at t = 1.5), and the frames hold the humanoid
+    (3,938 vertices) in K1 and K2, only F-cells in K3 and the quadruped (5,020 vertices: the file's
+    and the copies at its split corners) in K4 and K5."""
+    import subprocess
+    for f in ("BCN_Epileptic.X", "Testwuson.X"):
+        if not os.path.isfile("/usr/share/assimp/models/X/" + f):
+            print("SKIP: assimp-testmodels is not installed")
+            return
+    model = os.path.join(data, "Models", "icm", "metamorphosis_characters.icm")
+    pvd, trace = os.path.join(work, "characters.pvd"), os.path.join(work, "characters.jsonl")
+    args = ["run", model, "--frames", "0:6:1.25", "--size", "0.4", "-o", pvd, "--json",
+            "--trace", trace, "--threads", "2"]
+    p = subprocess.run([ictk] + args, capture_output=True, text=True, timeout=900)
+    if p.returncode != 0:
+        sys.exit(f"FAIL: ictk {' '.join(args)} exited {p.returncode}\n{p.stderr}")
+    summary = json.loads(p.stdout)
+    moves = [(t["to"], t["time"]) for t in summary["transitions"]]
+    if [m for m, _ in moves] != ["K2", "K3", "K4", "K5"]:
+        sys.exit(f"FAIL: transitions {moves}")
+    near(moves[0][1], 1, 1e-6, "K1 -> K2")
+    if not 1.4 < moves[1][1] <= 1.5:
+        sys.exit(f"FAIL: K2 -> K3 at {moves[1][1]}, not as alpha nears 1 (t = 1.5)")
+    near(moves[2][1], 4, 1e-6, "K3 -> K4")
+    near(moves[3][1], 5, 1e-6, "K4 -> K5")
+    states = [json.loads(line)["state"] for line in open(trace)]
+    residual, angle = states[-1]["residualAtSwitch"], states[-1]["angleAtSwitch"]
+    if not (0 <= residual < 1e-6 and 0 <= angle < 1):
+        sys.exit(f"FAIL: at the switch the residual is {residual}, the angle {angle} degrees")
+    datasets = pvd_frames(pvd, 5, 1.25)
+    for k, instance, cell, points in ((0, "K1", "Source", 3938), (1, "K2", "Source", 3938),
+                                      (2, "K3", None, 0), (4, "K5", "Target", 5020)):
+        cells = read_frame(os.path.join(work, datasets[k].get("file")))
+        if {i for _, i in cells.values()} != {instance}:
+            sys.exit(f"FAIL: frame {k} instances {[i for _, i in cells.values()]}")
+        if cell is None:
+            if set(cells) != {"Morph"} or cells["Morph"][0].GetNumberOfPoints() == 0:
+                sys.exit(f"FAIL: frame {k} (K3) holds {sorted(cells)}")
+        elif cells[cell][0].GetNumberOfPoints() != points:
+            sys.exit(f"FAIL: frame {k}: {cell} has {cells[cell][0].GetNumberOfPoints()} points")
+    print(f"K2 -> K3 at t = {moves[1][1]}: residual {residual}, angle {angle} degrees")
+
+
 def check_run_space_time(ictk, work):
     """A 4D cell through ictk run: a sphere of radius 0.5 + 0.5 t (hyperfun x[4]), whose frames
     at t = 0, 0.5, 1 are its cross-sections: spheres of diameter 1, 1.5 and 2 (issue 16: every
@@ -1628,11 +1674,11 @@ def main():
         print("OK")
         return
     if check in ("run-disk", "run-errors", "run-default", "sample-frames", "run-standin",
-                 "sample-icm"):
+                 "sample-icm", "run-characters"):
         {"run-disk": check_run_disk, "run-errors": check_run_errors,
          "run-default": check_run_default, "sample-frames": check_sample_frames,
          "sample-icm": check_sample_icm,
-         "run-standin": check_run_standin}[check](
+         "run-standin": check_run_standin, "run-characters": check_run_characters}[check](
             ictk, work, rest[0])
         print("OK")
         return
