@@ -1060,7 +1060,7 @@ def check_run_characters(ictk, work, data):
             return
     model = os.path.join(data, "Models", "icm", "metamorphosis_characters.icm")
     pvd, trace = os.path.join(work, "characters.pvd"), os.path.join(work, "characters.jsonl")
-    args = ["run", model, "--frames", "0:6:1.25", "--size", "0.4", "-o", pvd, "--json",
+    args = ["run", model, "--frames", "0:6:0.6", "--size", "0.4", "-o", pvd, "--json",
             "--trace", trace, "--threads", "2"]
     p = subprocess.run([ictk] + args, capture_output=True, text=True, timeout=900)
     if p.returncode != 0:
@@ -1078,9 +1078,10 @@ def check_run_characters(ictk, work, data):
     residual, angle = states[-1]["residualAtSwitch"], states[-1]["angleAtSwitch"]
     if not (0 <= residual < 1e-6 and 0 <= angle < 1):
         sys.exit(f"FAIL: at the switch the residual is {residual}, the angle {angle} degrees")
-    datasets = pvd_frames(pvd, 5, 1.25)
-    for k, instance, cell, points in ((0, "K1", "Source", 3938), (1, "K2", "Source", 3938),
-                                      (2, "K3", None, 0), (4, "K5", "Target", 5020)):
+    datasets = pvd_frames(pvd, 11, 0.6)
+    for k, instance, cell, points in ((0, "K1", "Source", 3938), (2, "K2", "Source", 3938),
+                                      (4, "K3", None, 0), (7, "K4", "Target", 5020),
+                                      (10, "K5", "Target", 5020)):
         cells = read_frame(os.path.join(work, datasets[k].get("file")))
         if {i for _, i in cells.values()} != {instance}:
             sys.exit(f"FAIL: frame {k} instances {[i for _, i in cells.values()]}")
