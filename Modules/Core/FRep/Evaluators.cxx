@@ -821,16 +821,27 @@ Interval detail::intervalOperationReference(
   return intervalOp(op, a, b, c, choice);
 }
 
+namespace
+{
+/// The leaves of an interval evaluator's values (constants or parameters) from `first` on: each
+/// value a point interval, NaN flagged.
+void writeIntervalLeaves(
+  const std::vector<double>& leaves, std::uint32_t first, std::vector<Interval>& values)
+{
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+  {
+    const double v = leaves[i];
+    values[first + i] = { v, v, std::isnan(v) };
+  }
+}
+} // namespace
+
 IntervalEvaluator::IntervalEvaluator(TapePtr tape, const std::vector<double>& parameters)
   : tape_(std::move(tape))
   , slots_(tape_->slotCount())
   , choices_(tape_->instructions().size(), Choice::Both)
 {
-  for (std::size_t i = 0; i < tape_->constants().size(); ++i)
-  {
-    const double v = tape_->constants()[i];
-    slots_[tape_->constantBase() + i] = { v, v, std::isnan(v) };
-  }
+  writeIntervalLeaves(tape_->constants(), tape_->constantBase(), slots_);
   setParameters(parameters);
 }
 
@@ -838,10 +849,7 @@ void IntervalEvaluator::setParameters(const std::vector<double>& parameters)
 {
   std::vector<double> p;
   loadParameters(*tape_, parameters, p);
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    slots_[tape_->parameterBase() + i] = { p[i], p[i], std::isnan(p[i]) };
-  }
+  writeIntervalLeaves(p, tape_->parameterBase(), slots_);
 }
 
 Interval IntervalEvaluator::eval(const Region& region)
@@ -920,11 +928,7 @@ IncrementalIntervalEvaluator::IncrementalIntervalEvaluator(
   , values_(ssa_.valueCount)
   , choices_(tape_->instructions().size(), Choice::Both)
 {
-  for (std::size_t i = 0; i < tape_->constants().size(); ++i)
-  {
-    const double v = tape_->constants()[i];
-    values_[tape_->constantBase() + i] = { v, v, std::isnan(v) };
-  }
+  writeIntervalLeaves(tape_->constants(), tape_->constantBase(), values_);
   setParameters(parameters);
 }
 
@@ -932,10 +936,7 @@ void IncrementalIntervalEvaluator::setParameters(const std::vector<double>& para
 {
   std::vector<double> p;
   loadParameters(*tape_, parameters, p);
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    values_[tape_->parameterBase() + i] = { p[i], p[i], std::isnan(p[i]) };
-  }
+  writeIntervalLeaves(p, tape_->parameterBase(), values_);
   // The instructions record the axes they depend on, not the parameters: all run again.
   first_ = true;
 }
