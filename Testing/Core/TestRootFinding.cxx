@@ -10,6 +10,8 @@
 
 using ictk::frep::Crossing;
 using ictk::frep::locateCrossing;
+using ictk::frep::LocateOptions;
+using ictk::frep::refineRoot;
 
 TEST(FRepRootFinding, SignChangeIsRefined)
 {
@@ -27,6 +29,39 @@ TEST(FRepRootFinding, SignChangeIsRefined)
   ASSERT_TRUE(e);
   EXPECT_NEAR(e->time, 1.2, 1e-12);
   EXPECT_FALSE(locateCrossing([](double t) { return t + 1.0; }, 0.0, 1.0));
+}
+
+TEST(FRepRootFinding, AConvergedSecantPointClosesTheBracket)
+{
+  // The ray caster's case: a bracket a thousand tolerances wide around a simple root.
+  // cos(t) - 1/2 on [1.04, 1.05]: the root is pi/3 = 1.0471975511965976.
+  LocateOptions o;
+  o.timeTolerance = 1e-5;
+  int evaluations = 0;
+  auto g = [](double t)
+  {
+    return std::cos(t) - 0.5;
+  };
+  const double r = refineRoot(g, 1.04, g(1.04), 1.05, g(1.05), o, &evaluations);
+  EXPECT_NEAR(r, std::acos(0.5), 1e-5);
+  // Two secant steps reach the root to about 1e-9; the third point, half a tolerance inside,
+  // closes the bracket (Illinois alone took 5).
+  EXPECT_EQ(evaluations, 3);
+  // To the default tolerance 1e-12: t^3 - 2 on [1, 2] (Illinois alone took 11).
+  evaluations = 0;
+  auto h = [](double t)
+  {
+    return t * t * t - 2.0;
+  };
+  EXPECT_NEAR(
+    refineRoot(h, 1.0, -1.0, 2.0, 6.0, LocateOptions{}, &evaluations), std::cbrt(2.0), 1e-12);
+  EXPECT_LE(evaluations, 9);
+  // A linear g: the first secant point is the root, the second closes the bracket around it.
+  evaluations = 0;
+  EXPECT_NEAR(refineRoot([](double t) { return 3.0 - t; }, 2.5, 0.5, 3.7, -0.7, LocateOptions{},
+                &evaluations),
+    3.0, 1e-12);
+  EXPECT_LE(evaluations, 2);
 }
 
 TEST(FRepRootFinding, InstantaneousTouchIsFound)

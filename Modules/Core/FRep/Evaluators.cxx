@@ -710,7 +710,9 @@ inline bool plain(const Interval& a)
 // branches for such operands reduce to these lines), and inlined into the evaluation loops, so
 // that an instruction costs its arithmetic and its outward rounding rather than two dispatches
 // and a call. Every other case goes to intervalOp.
-inline Interval fastIntervalOp(
+// Always inlined: the incremental evaluator calls it from two loops, where GCC otherwise makes it a
+// call (14 % more instructions for render-sphere-gyroid).
+[[gnu::always_inline]] inline Interval fastIntervalOp(
   Opcode op, const Interval& a, const Interval& b, const Interval& c, Choice& choice)
 {
   switch (op)
@@ -901,11 +903,30 @@ SsaCode::SsaCode(const Tape& tape)
       mask = static_cast<std::uint8_t>(mask | axesOf[*to[k]]);
     }
     axesOf[v] = mask;
+    used = static_cast<std::uint8_t>(used | mask);
     valueInSlot[ins.out] = v;
     code.push_back(out);
     axes.push_back(mask);
   }
   output = valueInSlot[tape.outputs()[0]];
+}
+
+const std::vector<std::uint32_t>& SsaCode::dependents(unsigned changed)
+{
+  changed &= 0xf;
+  std::vector<std::uint32_t>& list = dependents_[changed];
+  if (!(listed_ & (1u << changed)))
+  {
+    for (std::uint32_t i = 0; i < axes.size(); ++i)
+    {
+      if (axes[i] & changed)
+      {
+        list.push_back(i);
+      }
+    }
+    listed_ = static_cast<std::uint16_t>(listed_ | (1u << changed));
+  }
+  return list;
 }
 
 namespace
@@ -952,18 +973,25 @@ Interval IncrementalIntervalEvaluator::eval(const Region& region)
       changed |= 1u << a;
     }
   }
-  // The first eval also computes the instructions of constants and parameters alone.
-  const std::uint8_t all = first_ ? 0xff : 0;
-  first_ = false;
   const auto& code = ssa_.code;
-  for (std::size_t i = 0; i < code.size(); ++i)
+  auto run = [&](std::size_t i) __attribute__((always_inline))
   {
-    if ((ssa_.axes[i] | all) & changed)
+    const Instruction& ins = code[i];
+    values_[ins.out] =
+      fastIntervalOp(ins.op, values_[ins.a], values_[ins.b], values_[ins.c], choices_[i]);
+  };
+  if (first_)
+  {
+    // The first eval also computes the instructions of constants and parameters alone.
+    first_ = false;
+    for (std::size_t i = 0; i < code.size(); ++i)
     {
-      const Instruction& ins = code[i];
-      values_[ins.out] =
-        fastIntervalOp(ins.op, values_[ins.a], values_[ins.b], values_[ins.c], choices_[i]);
+      run(i);
     }
+  }
+  else
+  {
+    ssa_.forEachDependent(changed, run);
   }
   return values_[ssa_.output];
 }
@@ -1000,17 +1028,24 @@ double IncrementalPointEvaluator::eval(double x, double y, double z, double t)
       changed |= 1u << a;
     }
   }
-  const std::uint8_t all = first_ ? 0xff : 0;
-  first_ = false;
   double* s = values_.data();
   const auto& code = ssa_.code;
-  for (std::size_t i = 0; i < code.size(); ++i)
+  auto run = [&](std::size_t i) __attribute__((always_inline))
   {
-    if ((ssa_.axes[i] | all) & changed)
+    const Instruction& ins = code[i];
+    s[ins.out] = applyScalar<double>(ins.op, s[ins.a], s[ins.b], s[ins.c]);
+  };
+  if (first_)
+  {
+    first_ = false;
+    for (std::size_t i = 0; i < code.size(); ++i)
     {
-      const Instruction& ins = code[i];
-      s[ins.out] = applyScalar<double>(ins.op, s[ins.a], s[ins.b], s[ins.c]);
+      run(i);
     }
+  }
+  else
+  {
+    ssa_.forEachDependent(changed, run);
   }
   return s[ssa_.output];
 }

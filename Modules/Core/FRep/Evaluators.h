@@ -121,6 +121,36 @@ struct SsaCode
   std::vector<std::uint8_t> axes; ///< per instruction: bit a set when it depends on Axis(a)
   std::uint32_t valueCount = 0;
   std::uint32_t output = 0; ///< the value id of the first output
+  std::uint8_t used = 0;    ///< the axes some instruction depends on
+  /// The instructions (indices into code) that depend on an axis in `changed` (bit a: Axis(a)),
+  /// listed when first asked, so that an eval runs them without testing the others.
+  const std::vector<std::uint32_t>& dependents(unsigned changed);
+  /// Calls run(i) for every instruction i that depends on an axis in `changed`, in order: when
+  /// every axis changed, by testing each instruction's axes (a list would only add an
+  /// indirection), else from the list.
+  template <typename Run>
+  void forEachDependent(unsigned changed, Run&& run)
+  {
+    if ((changed & used) == used)
+    {
+      for (std::size_t i = 0; i < code.size(); ++i)
+      {
+        if (axes[i] & changed)
+        {
+          run(i);
+        }
+      }
+      return;
+    }
+    for (const std::uint32_t i : dependents(changed))
+    {
+      run(i);
+    }
+  }
+
+private:
+  std::array<std::vector<std::uint32_t>, 16> dependents_;
+  std::uint16_t listed_ = 0; ///< bit m: dependents_[m] is made
 };
 
 /// The same enclosures and choices as IntervalEvaluator, for regions that often differ from the

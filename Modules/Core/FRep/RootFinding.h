@@ -16,8 +16,10 @@
 //  2. Sign change: at the first pair with g(s_i) g(s_i+1) < 0 (or an exact zero), the root is
 //     refined by the Illinois variant of regula falsi (secant steps that keep a bracket; the
 //     retained end's value is halved when it is kept twice, which restores superlinear
-//     convergence) until the bracket is shorter than `timeTolerance` or |g| <= `valueTolerance`.
-//     A linear g is solved by the first secant step exactly (up to rounding).
+//     convergence; a secant point within timeTolerance / 2 of an end is moved that far inside,
+//     so that the step after a converged one closes the bracket) until the bracket is shorter
+//     than `timeTolerance` or |g| <= `valueTolerance`. A linear g is solved by the first secant
+//     step exactly (up to rounding).
 //  3. Touch (an instantaneous tangency, g >= 0 touching 0 without changing sign): if no sign
 //     change precedes it and an interior sample s_i is a local minimum of |g| (|g(s_i)| <=
 //     |g(s_i-1)| and |g(s_i)| <= |g(s_i+1)|), |g| is minimised on [s_i-1, s_i+1] by golden-section

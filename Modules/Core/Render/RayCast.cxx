@@ -663,6 +663,23 @@ private:
       // of such pieces on render-sphere-gyroid), so the halves are bounded directly.
       return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
     }
+    if (!divisible || (b - a) * ray.length <= leafLength)
+    {
+      return leaf(ws, stage, ray, a, b);
+    }
+    if (!mayHold(ws, stage, ray, a, b))
+    {
+      return false;
+    }
+    // The tape is not simplified again along one pixel's ray: building a tape there cost more
+    // than the instructions it removes (9% of the time of render-sphere-gyroid-1024), and with
+    // the narrowings kept (TapeStage::narrowed) it saves nothing measurable either.
+    return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
+  }
+
+  /// An enclosure of f on the ray between depths a and b; false when f < 0 there.
+  bool mayHold(Workspace& ws, detail::Stage& stage, const Ray& ray, double a, double b) const
+  {
     Point3 lo = ray.at(a), hi = ray.at(b);
     for (int k = 0; k < 3; ++k)
     {
@@ -671,18 +688,7 @@ private:
         std::swap(lo[k], hi[k]);
       }
     }
-    if (!mayHold(ws, stage, lo, hi))
-    {
-      return false;
-    }
-    // The tape is not simplified again along one pixel's ray: building a tape there cost more
-    // than the instructions it removes (9% of the time of render-sphere-gyroid-1024), and with
-    // the narrowings kept (TapeStage::narrowed) it saves nothing measurable either.
-    if (divisible && (b - a) * ray.length > leafLength)
-    {
-      return segment(ws, stage, ray, a, m) || segment(ws, stage, ray, m, b);
-    }
-    return leaf(ws, stage, ray, a, b);
+    return mayHold(ws, stage, lo, hi);
   }
 
   double f(Workspace& ws, detail::Stage& stage, Ray& ray, double s)
@@ -698,7 +704,10 @@ private:
     return value;
   }
 
-  /// A piece no longer than a leaf whose interval did not exclude 0.
+  /// A piece no longer than a leaf. Its ends are sampled before it is bounded: an end inside
+  /// settles the piece without an interval, whose bound would only have confirmed it (on
+  /// render-sphere-gyroid, most leaves that are reached hold the surface); only a piece with both
+  /// ends outside needs the interval to tell an empty piece from a feature hiding inside it.
   bool leaf(Workspace& ws, detail::Stage& stage, Ray& ray, double a, double b)
   {
     const double fa = f(ws, stage, ray, a);
@@ -735,6 +744,10 @@ private:
       const double root = frep::refineRoot(g, a, std::isnan(fa) ? -1.0 : fa, b, fb, refine);
       found(ws, stage, ray, root, probe.inside);
       return true;
+    }
+    if (!mayHold(ws, stage, ray, a, b))
+    {
+      return false;
     }
     const double m = 0.5 * (a + b);
     if ((b - a) * ray.length <= tolerance_ || !(m > a && m < b))
