@@ -705,6 +705,16 @@ inline bool plain(const Interval& a)
     a.hi <= std::numeric_limits<double>::max() && a.lo <= a.hi;
 }
 
+// mul() of plain operands: finite products, so no NaN and no zero times infinity.
+[[gnu::always_inline]] inline Interval plainMul(const Interval& a, const Interval& b)
+{
+  const double p0 = a.lo * b.lo, p1 = a.lo * b.hi, p2 = a.hi * b.lo, p3 = a.hi * b.hi;
+  const Interval r{ nextDown(std::min(std::min(p0, p1), std::min(p2, p3))),
+    nextUp(std::max(std::max(p0, p1), std::max(p2, p3))), false };
+  const bool sameSign = (a.lo >= 0 && b.lo >= 0) || (a.hi <= 0 && b.hi <= 0);
+  return sameSign ? nonNegative(r) : r;
+}
+
 // intervalOp for the common opcodes on plain operands, without the checks that only NaN, empty
 // or infinite operands need (the same bounds, flags and choices bit for bit: intervalOp's
 // branches for such operands reduce to these lines), and inlined into the evaluation loops, so
@@ -736,12 +746,20 @@ inline bool plain(const Interval& a)
       if (plain(a) && plain(b))
       {
         choice = Choice::Both;
-        // Finite products: no NaN, no zero times infinity.
-        const double p0 = a.lo * b.lo, p1 = a.lo * b.hi, p2 = a.hi * b.lo, p3 = a.hi * b.hi;
-        const Interval r{ nextDown(std::min(std::min(p0, p1), std::min(p2, p3))),
-          nextUp(std::max(std::max(p0, p1), std::max(p2, p3))), false };
-        const bool sameSign = (a.lo >= 0 && b.lo >= 0) || (a.hi <= 0 && b.hi <= 0);
-        return sameSign ? nonNegative(r) : r;
+        return plainMul(a, b);
+      }
+      break;
+    case Opcode::Div:
+      // a times the widened reciprocal of b, as intervalOp: over a divisor that excludes 0 and
+      // whose reciprocal is finite (a divisor below 1/DBL_MAX in magnitude goes there).
+      if (plain(a) && plain(b) && (b.lo > 0 || b.hi < 0))
+      {
+        const Interval reciprocal{ nextDown(1.0 / b.hi), nextUp(1.0 / b.lo), false };
+        if (plain(reciprocal))
+        {
+          choice = Choice::Both;
+          return plainMul(a, reciprocal);
+        }
       }
       break;
     case Opcode::Min:
