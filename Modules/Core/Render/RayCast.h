@@ -25,10 +25,11 @@
 //      by intervals (with the tape of the last node: simplifying per piece of one ray costs more
 //      than it saves; a piece of at most two leaves is not checked whole, only its halves),
 //      front first, down to a leaf no longer than the pixel's footprint at that depth. In a
-//      leaf f is evaluated at both ends: a sign change is refined by Illinois
-//      (FRep/RootFinding.h refineRoot) to the depth tolerance; two negative ends under an
-//      interval that does not exclude 0 mean a feature may hide inside, so the leaf is halved
-//      again (intervals and samples) down to the depth tolerance. The evaluators are
+//      leaf f is evaluated at both ends first (an end inside settles the leaf, and its interval
+//      could only have confirmed that): a sign change is refined by Illinois
+//      (FRep/RootFinding.h refineRoot) to the depth tolerance; two negative ends are checked by
+//      the leaf's interval, and one that does not exclude 0 means a feature may hide inside, so
+//      the leaf is halved again (samples and intervals) down to the depth tolerance. The evaluators are
 //      incremental (FRep/Evaluators.h): successive pieces of one ray differ in z alone when the
 //      rays are parallel to z (an orthographic view along it), and then only the instructions
 //      that depend on z run again; the values are those of a full evaluation, bit for bit.
