@@ -18,6 +18,7 @@
 // ones by j1, the middle ring half and half; over 2 s j0 moves by (2, 0, 0) and j1 turns a quarter
 // about z, so every segment of its stand-in moves rigidly with one joint.
 
+#include "Discretize/Surface.h"
 #include "Engine/DynamicModel.h"
 #include "Engine/FrameSequence.h"
 #include "FRep/Evaluators.h"
@@ -35,6 +36,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -729,6 +731,117 @@ TEST(EngineSkeleton, TheMetamorphosisGoesFromTheSourceMeshToTheDestinationMesh)
   m.advanceTo(5.5, 0.25);
   EXPECT_EQ(m.activeInstance(), "K5");
   ExpectMesh(m, "Target", x.targetPlace, plain(x.target, 5.5), "t 5.5");
+}
+
+// T-5.5 item 3: the topology of the B-cells' meshes holds in K1/K2 (the source) and K4/K5 (the
+// destination): each frame's mesh, its vertices welded where the file's bind pose has the same
+// point (the file splits vertices along seams), has the bind pose's Euler characteristic, and the
+// vertices welded there stay together (the projection tears no seam). A change of topology can
+// only be the F-cell's: at the switch the Morph's surface (dual contouring) is closed, manifold
+// and has the source mesh's Euler characteristic, and from t1 on the destination's. (Both
+// meshes here are closed and of genus 0, so the Euler characteristics are 2 throughout.)
+template <typename Triangles>
+ictk::discretize::MeshTopology WeldedTopology(const std::vector<Vec3>& bind,
+  const Triangles& triangles, const std::vector<Vec3>& posed, double* seamGap = nullptr)
+{
+  std::map<std::array<double, 3>, std::uint32_t> first;
+  std::vector<std::uint32_t> weld(bind.size());
+  ictk::discretize::SurfaceMesh mesh;
+  for (std::uint32_t i = 0; i < bind.size(); ++i)
+  {
+    const auto [at, added] =
+      first.emplace(std::array<double, 3>{ bind[i][0], bind[i][1], bind[i][2] },
+        static_cast<std::uint32_t>(mesh.points.size()));
+    if (added)
+      mesh.points.push_back({ posed[i][0], posed[i][1], posed[i][2] });
+    weld[i] = at->second;
+    if (seamGap)
+    {
+      const auto& p = mesh.points[at->second];
+      for (int c = 0; c < 3; ++c)
+        *seamGap = std::max(*seamGap, std::abs(p[c] - posed[i][c]));
+    }
+  }
+  for (const auto& t : triangles)
+    mesh.triangles.push_back({ weld[static_cast<std::size_t>(t[0])],
+      weld[static_cast<std::size_t>(t[1])], weld[static_cast<std::size_t>(t[2])] });
+  return ictk::discretize::analyzeTopology(mesh);
+}
+
+TEST(EngineSkeleton, TheMeshesKeepTheirTopologyOutsideTheMorph)
+{
+  if (!skin::canReadSkinnedMeshFiles())
+    GTEST_SKIP() << "built without Assimp";
+  const Metamorphosis x;
+  engine::DynamicModel m = engine::DynamicModel::load(Write("metamorphosis.icm", x.text).string());
+  auto topologyOf = [&](const char* cell, const skin::SkinnedMesh& file, const std::string& when)
+  {
+    const auto cells = m.cells();
+    const auto& part = CellOf(cells, cell).shape->parts[0];
+    EXPECT_EQ(part.points.size(), file.restPoints.size()) << cell << " " << when;
+    double seamGap = 0;
+    const auto t = WeldedTopology(file.restPoints, part.triangles, part.points, &seamGap);
+    EXPECT_LT(seamGap, 1e-9) << cell << " " << when;
+    return t;
+  };
+  const auto source = WeldedTopology(x.source.restPoints, x.source.triangles, x.source.restPoints);
+  const auto target = WeldedTopology(x.target.restPoints, x.target.triangles, x.target.restPoints);
+  std::printf("source: V %zu E %zu F %zu, chi %ld, %zu components, %zu boundary edges\n",
+    source.vertices, source.edges, source.triangles, source.eulerCharacteristic, source.components,
+    source.boundaryEdges);
+  std::printf("target: V %zu E %zu F %zu, chi %ld, %zu components, %zu boundary edges\n",
+    target.vertices, target.edges, target.triangles, target.eulerCharacteristic, target.components,
+    target.boundaryEdges);
+  for (const double t : { 0.5, 1.0, 1.25, 1.45 })
+  {
+    m.advanceTo(t, 0.25);
+    ASSERT_TRUE(m.activeInstance() == "K1" || m.activeInstance() == "K2") << t;
+    const auto got = topologyOf("Source", x.source, "t " + std::to_string(t));
+    EXPECT_EQ(got.eulerCharacteristic, source.eulerCharacteristic) << t;
+    EXPECT_EQ(got.edges, source.edges) << t;
+    EXPECT_EQ(got.components, source.components) << t;
+  }
+  // K3: the Morph's surface, by dual contouring in its box with cells of 0.2.
+  auto morphTopology = [&](const engine::DynamicModel& model, const std::string& when)
+  {
+    const auto cells = model.cells();
+    const auto& morph = *CellOf(cells, "Morph").shape;
+    ictk::discretize::SurfaceOptions options;
+    options.featureSize = 0.2;
+    const auto t = ictk::discretize::analyzeTopology(ictk::discretize::contourSurface(
+      *ictk::geometry::worldField(morph), morph.worldBounds(), options));
+    std::printf("Morph at %s: chi %ld, %zu components, %zu triangles\n", when.c_str(),
+      t.eulerCharacteristic, t.components, t.triangles);
+    EXPECT_TRUE(t.manifold()) << when;
+    EXPECT_TRUE(t.closed()) << when;
+    return t;
+  };
+  double switchTime = -1;
+  for (const engine::FrameRecord& r : m.advanceTo(1.75, 0.25))
+    if (r.transition)
+      switchTime = r.time;
+  ASSERT_GT(switchTime, 1.49);
+  engine::DynamicModel atSwitch =
+    engine::DynamicModel::load(Write("metamorphosis.icm", x.text).string());
+  atSwitch.advanceTo(switchTime, 0.25);
+  ASSERT_EQ(atSwitch.activeInstance(), "K3");
+  const auto first = morphTopology(atSwitch, "the switch");
+  EXPECT_EQ(first.eulerCharacteristic, source.eulerCharacteristic);
+  EXPECT_EQ(first.components, source.components);
+  m.advanceTo(3.75, 0.25);
+  ASSERT_EQ(m.activeInstance(), "K3");
+  const auto last = morphTopology(m, "t 3.75");
+  EXPECT_EQ(last.eulerCharacteristic, target.eulerCharacteristic);
+  EXPECT_EQ(last.components, target.components);
+  for (const double t : { 4.0, 4.25, 4.75, 5.5 })
+  {
+    m.advanceTo(t, 0.25);
+    ASSERT_TRUE(m.activeInstance() == "K4" || m.activeInstance() == "K5") << t;
+    const auto got = topologyOf("Target", x.target, "t " + std::to_string(t));
+    EXPECT_EQ(got.eulerCharacteristic, target.eulerCharacteristic) << t;
+    EXPECT_EQ(got.edges, target.edges) << t;
+    EXPECT_EQ(got.components, target.components) << t;
+  }
 }
 
 // T-5.5 item 5 in the model: with the weight map sourceTop the vertices of the higher z (in the
