@@ -19,6 +19,7 @@
 #include "Render/ComplexRender.h"
 #include "Render/RayCast.h"
 #include "Render/TetCut.h"
+#include "ictkComplexToVTK.h"
 #include "ictkSolverResults.h"
 
 #include <vtkCellData.h>
@@ -26,7 +27,6 @@
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkUnstructuredGrid.h>
-#include <vtkXMLUnstructuredGridReader.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -695,18 +695,14 @@ private:
       depthFile.emplace(this->Depth);
     }
     const auto t0 = Clock::now();
-    vtkNew<vtkXMLUnstructuredGridReader> reader;
-    reader->SetFileName(this->Model.c_str());
-    // VTK's reader reports a file it cannot parse as VTK errors: the first becomes our line.
-    ictkCaptureOutputWindow* messages = CaptureVtkMessages();
-    const std::size_t errorsBefore = messages->Errors.size();
-    reader->Update();
-    vtkUnstructuredGrid* grid = reader->GetOutput();
-    if (reader->GetErrorCode() != 0 || !grid || messages->Errors.size() > errorsBefore)
+    vtkSmartPointer<vtkUnstructuredGrid> grid;
+    try
     {
-      const std::string cause = messages->FirstCause(errorsBefore);
-      throw UserError("cannot read '" + this->Model + "' as a VTK unstructured grid (.vtu)" +
-        (cause.empty() ? std::string() : ": " + cause));
+      grid = ictk::vtk::readUnstructuredGrid(this->Model);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      throw UserError(e.what());
     }
     mesh::TetMesh m;
     try

@@ -11,11 +11,11 @@
 
 #include "Mesh/Calculix.h"
 #include "Mesh/Frd.h"
+#include "ictkComplexToVTK.h"
 #include "ictkSolverResults.h"
 
 #include <vtkNew.h>
 #include <vtkUnstructuredGrid.h>
-#include <vtkXMLUnstructuredGridReader.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -100,14 +100,16 @@ int SolveCommand::run()
     throw UserError("cannot read '" + o.Mesh + "'");
   }
   const auto t0 = std::chrono::steady_clock::now();
-  vtkNew<vtkXMLUnstructuredGridReader> reader;
-  reader->SetFileName(o.Mesh.c_str());
-  reader->Update();
-  if (reader->GetErrorCode() != 0 || !reader->GetOutput())
+  vtkSmartPointer<vtkUnstructuredGrid> grid;
+  try
   {
-    throw UserError("cannot read '" + o.Mesh + "' as a VTK unstructured grid");
+    grid = ictk::vtk::readUnstructuredGrid(o.Mesh);
   }
-  const mesh::TetMesh m = ictk::vtk::tetMeshFromVTK(reader->GetOutput(), o.Mesh);
+  catch (const std::invalid_argument& e)
+  {
+    throw UserError(e.what());
+  }
+  const mesh::TetMesh m = ictk::vtk::tetMeshFromVTK(grid, o.Mesh);
   AtomicOutput file(o.Output);
   CompressionSettings settings;
   settings.work = o.Work.empty()

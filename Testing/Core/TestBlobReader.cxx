@@ -186,6 +186,11 @@ TEST(BlobReader, TRexModel)
   EXPECT_EQ(
     i0.count(Kind::Cylinder) + i0.count(Kind::ConeSphere) + i0.count(Kind::Segment), 66u * 28);
   EXPECT_NEAR(static_cast<double>(i0.leafCount()), 1835.0, 0.05 * 1835);
+  // Exactly: the cylinders' 1,848 segments and 18 points, the 1,866 skeletal elements that
+  // `ictk bench --only trex` reports (docs/blobtree.md, docs/performance.md).
+  EXPECT_EQ(i0.count(Kind::Point), 18u);
+  EXPECT_EQ(i0.leafCount(), 1866u);
+  EXPECT_EQ(i0.operatorCount(), 1812u);
   ASSERT_EQ(i0.nodes().size(), i1.nodes().size());
   for (std::size_t k = 0; k < i0.nodes().size(); ++k)
   {

@@ -327,8 +327,10 @@ TEST(BlobTree, RFunctionBooleans)
     EXPECT_NEAR(unionR(x, x, T), x, 1e-15);
     EXPECT_NEAR(intersectionR(x, x, T), x, 1e-15);
   }
-  EXPECT_EQ(unionR(0, 0, T), 0.0);
-  EXPECT_EQ(intersectionR(0, 0, T), 0.0);
+  // 0 up to the rounding of T + (u + v + sqrt(u^2 + v^2)) / (2 - sqrt 2) at u = v = -T (the
+  // union's sum, -T (2 - sqrt 2), is computed without cancellation as a quotient, -1.1e-16 off).
+  EXPECT_NEAR(unionR(0, 0, T), 0.0, 2e-16);
+  EXPECT_NEAR(intersectionR(0, 0, T), 0.0, 2e-16);
   EXPECT_NEAR(unionR(0.7, 0.7, T), 1.665685, 5e-7);
   EXPECT_NEAR(intersectionR(0.7, 0.7, T), 0.534315, 5e-7);
   EXPECT_NEAR(unionR(1, 0, T), 1.707107, 5e-7);

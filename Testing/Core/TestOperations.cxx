@@ -105,6 +105,71 @@ TEST(Operations, AlphaSystemMatchesFormulaOnSamples)
   }
 }
 
+TEST(Operations, RFunctionsStayExactNextToAFarOperand)
+{
+  // Next to a far operand the plain sum f1 + f2 + sqrt(f1^2 + f2^2) cancels: at (-1e8, 1) it
+  // gave 1 for 1.000000005, at (-1e8, 1e-9) 0 for 1e-9, the nearer surface lost. The exact values
+  // below are those of the formulas on the same double operands in 80-digit decimal arithmetic,
+  // rounded to double; every path must give them to 4 ulps.
+  struct Case
+  {
+    Shape shape;
+    double f1, f2, exact;
+  };
+  const Case cases[] = {
+    { unite(probe1, probe2), -1e8, 1, 1.000000005 },
+    { unite(probe1, probe2), -1e8, 1e-9, 1e-9 },
+    { unite(probe1, probe2), 1e-9, -1e8, 1e-9 },
+    { unite(probe1, probe2), -1e8, -1, -0.999999995 },
+    { unite(probe1, probe2, 0.5), -1e8, 0.5, 0.500000000625 },
+    { unite(probe1, probe2, -0.5), -1e8, 0.5, 0.500000001875 },
+    { intersect(probe1, probe2), 1e8, -1, -1.000000005 },
+    { intersect(probe1, probe2), 1e8, 1e-9, 1e-9 },
+    { intersect(probe1, probe2), 1e8, 1, 0.999999995 },
+    { subtract(probe1, probe2), 1e8, -1e-9, 1e-9 },
+    { blendUnion(probe1, probe2, 1, 1, 1), -1e8, 1e-9, 1.0000001e-09 },
+    { blendIntersection(probe1, probe2, 1, 1, 1), 1e8, 1e-9, 1.0000001e-09 },
+  };
+  const double ulps = 4 * std::numeric_limits<double>::epsilon();
+  for (const Case& c : cases)
+  {
+    SCOPED_TRACE(c.shape.label() + " at " + std::to_string(c.f1) + ", " + std::to_string(c.f2));
+    const double tolerance = ulps * std::fabs(c.exact);
+    EXPECT_NEAR(eval(c.shape, c.f1, c.f2), c.exact, tolerance);
+    PointEvaluator point(Tape::compile(c.shape.function()));
+    EXPECT_NEAR(point.eval(c.f1, c.f2), c.exact, tolerance);
+    GradientEvaluator gradient(Tape::compile(c.shape.function()));
+    EXPECT_NEAR(gradient.eval(c.f1, c.f2).value, c.exact, tolerance);
+    // A box about the operands encloses the values at its corners and, like them, has one sign.
+    IntervalEvaluator interval(Tape::compile(c.shape.function()));
+    const double w1 = std::min(1.0, 0.25 * std::fabs(c.f1)),
+                 w2 = std::min(1.0, 0.25 * std::fabs(c.f2));
+    const Interval range = interval.eval(Region{ { Interval{ c.f1 - w1, c.f1 + w1 },
+      Interval{ c.f2 - w2, c.f2 + w2 }, Interval{ 0, 0 }, Interval{ 0, 0 } } });
+    for (double d1 : { -w1, w1 })
+    {
+      for (double d2 : { -w2, w2 })
+      {
+        const double v = point.eval(c.f1 + d1, c.f2 + d2);
+        EXPECT_TRUE(range.lo <= v && v <= range.hi) << v << " " << range.lo << " " << range.hi;
+      }
+    }
+    EXPECT_TRUE(c.exact > 0 ? range.lo > 0 : range.hi < 0) << range.lo << " " << range.hi;
+  }
+  // The double forms are the same formulas.
+  EXPECT_NEAR(rUnion(-1e8, 1e-9), 1e-9, ulps * 1e-9);
+  EXPECT_NEAR(rIntersection(1e8, -1.0), -1.000000005, ulps);
+  EXPECT_NEAR(rUnion(-1e8, 0.5, 0.5), 0.500000000625, ulps);
+  EXPECT_EQ(rUnion(-2.0, 3.0, 1.0), 3.0);
+  EXPECT_EQ(rIntersection(-2.0, 3.0, 1.0), -2.0);
+  // The gradient (1 + f1 / r, 1 + f2 / r) at (-1e8, 1): 1 - 1e8 / sqrt(1e16 + 1) = 5e-17, where
+  // the sum's derivative gave 0, and 1.00000001.
+  GradientEvaluator gradient(Tape::compile(unite(probe1, probe2).function()));
+  const ValueGradient g = gradient.eval(-1e8, 1);
+  EXPECT_NEAR(g.gradient[0], 5e-17, 1e-22);
+  EXPECT_NEAR(g.gradient[1], 1.00000001, ulps);
+}
+
 TEST(Operations, RFunctionSignAgreesWithMinMax)
 {
   // Spec item 12 (L626): sign(R-union) = sign(max), sign(R-intersection) = sign(min).

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -143,14 +144,16 @@ TEST(Primitives3D, Block)
 TEST(Primitives3D, BlockRFunctionFollowsHfBlock)
 {
   // hfBlock with ALPHA = 0 at the center (1, 2, 3) of [0,2]x[0,4]x[0,6]: slabs 1, 4, 9;
-  // g = 1 + 4 - sqrt(1 + 16) = 5 - sqrt(17), then g + 9 - sqrt(g^2 + 81).
-  const double g = 5 - std::sqrt(17.0);
+  // g = 1 + 4 - sqrt(1 + 16) = 5 - sqrt(17), then g + 9 - sqrt(g^2 + 81) = 0.83427618362456564...
+  // (50-digit decimal arithmetic). That formula in doubles is 2e-15 off (its cancellation); the
+  // kernel's R-intersection, computed without it, is within 2 ulps.
+  const double ulp2 = 2 * std::numeric_limits<double>::epsilon();
   const Shape s0 = blockRFunction({ 0, 0, 0 }, 2, 4, 6, 0.0);
-  EXPECT_NEAR(at(s0, 1, 2, 3), g + 9 - std::sqrt(g * g + 81), 1e-15);
-  // With alpha = 0.5: g = 5 - sqrt(1 + 16 - 4) = 5 - sqrt(13), then g + 9 - sqrt(g^2 + 81 - 9 g).
-  const double h = 5 - std::sqrt(13.0);
+  EXPECT_NEAR(at(s0, 1, 2, 3), 0.83427618362456564, ulp2 * 0.83);
+  // With alpha = 0.5: g = 5 - sqrt(1 + 16 - 4) = 5 - sqrt(13), then
+  // g + 9 - sqrt(g^2 + 81 - 9 g) = 2.0043087540387359...
   const Shape s5 = blockRFunction({ 0, 0, 0 }, 2, 4, 6, 0.5);
-  EXPECT_NEAR(at(s5, 1, 2, 3), h + 9 - std::sqrt(h * h + 81 - 9 * h), 1e-15);
+  EXPECT_NEAR(at(s5, 1, 2, 3), 2.0043087540387359, ulp2 * 2);
   // On a face one slab is 0: 0 + f2 - |f2| = 0, then 0 + f3 - |f3| = 0.
   EXPECT_NEAR(at(s0, 0, 2, 3), 0, 1e-15);
   // alpha = 1 is exactly the min (block()).

@@ -30,9 +30,9 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -191,9 +191,10 @@ TEST(TimeSeriesWriter, WritesEveryFrameOfTheDynamicSource)
   for (std::size_t k = 0; k < datasets.size(); ++k)
   {
     EXPECT_EQ(datasets[k].first, static_cast<double>(k));
-    char name[32];
-    std::snprintf(name, sizeof(name), "disk/disk_%04zu.vtpc", k);
-    EXPECT_EQ(datasets[k].second, name);
+    // The frame number padded to four digits, as the writer names its files.
+    std::ostringstream name;
+    name << "disk/disk_" << std::setw(4) << std::setfill('0') << k << ".vtpc";
+    EXPECT_EQ(datasets[k].second, name.str());
   }
   // Frame 5 (t = 5, instance K3: 7 cells) read back is what the source gives at t = 5.
   vtkNew<vtkXMLPartitionedDataSetCollectionReader> reader;

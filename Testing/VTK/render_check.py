@@ -446,7 +446,7 @@ def check_tetmesh_mesh_mode(ictk, work):
     with open(garbage, "w") as f:
         f.write("not XML\n")
     for path, message in ((empty, f"'{empty}' has no cells"),
-                          (garbage, f"cannot read '{garbage}' as a VTK unstructured grid"),
+                          (garbage, f"cannot read '{garbage}': not an XML file"),
                           (os.path.join(work, "nope.vtu"), "cannot read '")):
         out = os.path.join(work, "bad.png")
         q = subprocess.run([ictk, "render", path, "--mode", "mesh", "-o", out],
@@ -569,14 +569,30 @@ def check_tetcut(ictk, work, data):
     w.SetFileName(triangles)
     w.SetInputData(grid)
     w.Write()
-    for path, message in ((garbage, "as a VTK unstructured grid (.vtu): Error parsing XML"),
+    # A grid without a points object: VTK's writer leaves out its <Points> element and VTK's
+    # reader says "No Points element available in first piece found in file. Reading file may
+    # fail."; ICTK's one line names the file instead, for every command that reads a .vtu.
+    no_points = os.path.join(work, "no-points.vtu")
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(no_points)
+    w.SetInputData(vtk.vtkUnstructuredGrid())
+    w.Write()
+    for path, message in ((garbage, f"cannot read '{garbage}': not an XML file"),
                           (triangles, "cell 0 is a vtkTriangle, not a tetrahedron"),
+                          (no_points, f"cannot read '{no_points}': it has no points"),
                           (os.path.join(work, "nope.vtu"), "cannot read '")):
         out = os.path.join(work, "bad.png")
         q = subprocess.run([ictk, "render", path, "-o", out], capture_output=True, text=True)
         lines = q.stderr.strip().splitlines()
         if q.returncode != 2 or len(lines) != 1 or message not in lines[0] or os.path.exists(out):
             sys.exit(f"FAIL: {path}: exit {q.returncode}, stderr:\n{q.stderr}")
+    out = os.path.join(work, "bad-solved.vtu")
+    q = subprocess.run([ictk, "solve", no_points, "--compression", "0.01", "-o", out],
+                       capture_output=True, text=True)
+    lines = q.stderr.strip().splitlines()
+    if (q.returncode != 2 or len(lines) != 1 or f"cannot read '{no_points}': it has no points"
+            not in lines[0] or os.path.exists(out)):
+        sys.exit(f"FAIL: solve {no_points}: exit {q.returncode}, stderr:\n{q.stderr}")
     q = subprocess.run([ictk, "render", "walnut", "-o", os.path.join(work, "bad.png"), "--cut",
                         "1,0,0,0"], capture_output=True, text=True)
     if q.returncode != 2 or "--cut cuts a tetrahedral mesh (.vtu) open" not in q.stderr:

@@ -7,6 +7,7 @@
 // uses them (with the TextureTree's materials) belong together; time and instantiation are in
 // BlobTreeInstance.cxx.
 #include "FRep/BlobTree.h"
+#include "FRep/Operations.h"
 #include "FRep/SolidTexture.h"
 
 #include <algorithm>
@@ -386,21 +387,21 @@ Box elementBox(Kind kind, const double* values, std::uint32_t count)
   return b;
 }
 
-// --- operators (papers.md 3.3)
+// --- operators (papers.md 3.3; the R_0 pair is the kernel's, computed without cancellation)
 // ---------------------------------------------------------------------
 template <class S>
 S unionRT(const S& a, const S& b, double T)
 {
   const S u = a - T;
   const S v = b - T;
-  return T + (1.0 / (2.0 - std::sqrt(2.0))) * (u + v + sqrt(square(u) + square(v)));
+  return T + (1.0 / (2.0 - std::sqrt(2.0))) * rUnion(u, v);
 }
 template <class S>
 S intersectionRT(const S& a, const S& b, double T)
 {
   const S u = a - T;
   const S v = b - T;
-  return T + (1.0 / (2.0 + std::sqrt(2.0))) * (u + v - sqrt(square(u) + square(v)));
+  return T + (1.0 / (2.0 + std::sqrt(2.0))) * rIntersection(u, v);
 }
 // Negative fields (a difference's 2T - f_B) are clamped so that f^n stays defined.
 template <class S>

@@ -98,7 +98,77 @@ Shape mapped(const Shape& a, const std::array<Expr, AxisCount>& map, const char*
 
 // --- the scalar forms, on Exprs -----------------------------------------------------------------
 
-Expr rUnion(const Expr& f1, const Expr& f2, double alpha)
+// The alpha-system's R-functions for both scalar types, Expr and double, one formula each.
+namespace rfunction
+{
+inline double select(double condition, double ifTrue, double ifFalse)
+{
+  return condition >= 0 ? ifTrue : ifFalse;
+}
+inline double square(double a)
+{
+  return a * a;
+}
+inline double sqrt(double a)
+{
+  return std::sqrt(a);
+}
+// Expr's min and max: the first operand where either is NaN.
+inline double min(double a, double b)
+{
+  return b < a ? b : a;
+}
+inline double max(double a, double b)
+{
+  return a < b ? b : a;
+}
+
+// sqrt(f1^2 + f2^2 - 2 alpha f1 f2). For |alpha| < 1 the radicand is >= (1 - |alpha|)(f1^2 + f2^2)
+// >= 0; the max only guards against rounding when alpha is close to 1.
+template <class S>
+S root(const S& f1, const S& f2, double alpha)
+{
+  if (alpha == 0.0)
+  {
+    return sqrt(square(f1) + square(f2));
+  }
+  return sqrt(max(square(f1) + square(f2) - 2.0 * alpha * f1 * f2, S(0.0)));
+}
+
+// s + r with s = f1 + f2 and r = root(f1, f2, alpha): (1 + alpha) times the R-union. Where s < 0
+// the sum cancels, and the nearer operand is lost next to a far one (f1 = -1e8, f2 = 1e-9 gives 0,
+// not about 1e-9). There it is the quotient -2 (1 + alpha) f1 f2 / (r - s) instead, the same number
+// ((s + r)(r - s) = r^2 - s^2 = -2 (1 + alpha) f1 f2) made of a product and a sum of two terms of
+// one sign (r - s >= -s > 0 where it is taken). Where s >= 0 the sum has no cancellation, and
+// the quotient, 0/0 at f1 = f2 = 0, is not taken.
+// The quotient lies in [s, r] where it is taken, and it is clamped to [s, 2 r]: an identity on its
+// values (each bound is at least r away from s + r), but an interval box where s takes both signs
+// encloses both branches, and there numerator and denominator can both contain 0 (a box around
+// f1 = f2 = 0), which alone would enclose the union in [-inf, inf]. The quotient is the second
+// operand of min and max, which return the first where either is NaN (Evaluators.cxx), so that an
+// operand flagged as possibly NaN does not bring the unbounded quotient back.
+template <class S>
+S sumPlusRoot(const S& f1, const S& f2, double alpha)
+{
+  const S s = f1 + f2;
+  const S r = root(f1, f2, alpha);
+  const S quotient = -2.0 * (1.0 + alpha) * f1 * f2 / (r - s);
+  return select(s, s + r, min(2.0 * r, max(s, quotient)));
+}
+
+// s - r, (1 + alpha) times the R-intersection: the mirror image (s - r = -((-s) + r)), the quotient
+// 2 (1 + alpha) f1 f2 / (s + r) where s > 0, clamped to [-2 r, s].
+template <class S>
+S sumMinusRoot(const S& f1, const S& f2, double alpha)
+{
+  const S s = f1 + f2;
+  const S r = root(f1, f2, alpha);
+  const S quotient = 2.0 * (1.0 + alpha) * f1 * f2 / (s + r);
+  return select(-s, s - r, max(-2.0 * r, min(s, quotient)));
+}
+
+template <class S>
+S unionOf(const S& f1, const S& f2, double alpha)
 {
   if (alpha == 1.0)
   {
@@ -108,15 +178,14 @@ Expr rUnion(const Expr& f1, const Expr& f2, double alpha)
   if (alpha == 0.0)
   {
     // Thesis L620.
-    return f1 + f2 + sqrt(square(f1) + square(f2));
+    return sumPlusRoot(f1, f2, 0.0);
   }
-  // thesis_ch2_3.md 1.7 [EXT]. For |alpha| < 1 the radicand is >= (1 - |alpha|)(f1^2 + f2^2) >= 0;
-  // the max only guards against rounding when alpha is close to 1.
-  const Expr radicand = square(f1) + square(f2) - 2.0 * alpha * f1 * f2;
-  return (f1 + f2 + sqrt(max(radicand, Expr(0.0)))) / (1.0 + alpha);
+  // thesis_ch2_3.md 1.7 [EXT].
+  return sumPlusRoot(f1, f2, alpha) / (1.0 + alpha);
 }
 
-Expr rIntersection(const Expr& f1, const Expr& f2, double alpha)
+template <class S>
+S intersectionOf(const S& f1, const S& f2, double alpha)
 {
   if (alpha == 1.0)
   {
@@ -125,11 +194,11 @@ Expr rIntersection(const Expr& f1, const Expr& f2, double alpha)
   if (alpha == 0.0)
   {
     // Thesis L622.
-    return f1 + f2 - sqrt(square(f1) + square(f2));
+    return sumMinusRoot(f1, f2, 0.0);
   }
-  const Expr radicand = square(f1) + square(f2) - 2.0 * alpha * f1 * f2;
-  return (f1 + f2 - sqrt(max(radicand, Expr(0.0)))) / (1.0 + alpha);
+  return sumMinusRoot(f1, f2, alpha) / (1.0 + alpha);
 }
+} // namespace rfunction
 
 // (f1^2 + f2^2)^(m/2) for an integer m >= 0, written with integer powers and one sqrt so that
 // every evaluator gets it exactly.
@@ -263,6 +332,31 @@ Expr maxTree(std::vector<Expr> values)
 } // namespace
 
 // --- set-theoretic operations ------------------------------------------------------------------
+
+Expr rUnion(const Expr& f1, const Expr& f2, double alpha)
+{
+  return rfunction::unionOf(f1, f2, alpha);
+}
+
+Expr rIntersection(const Expr& f1, const Expr& f2, double alpha)
+{
+  return rfunction::intersectionOf(f1, f2, alpha);
+}
+
+double rUnion(double f1, double f2, double alpha)
+{
+  return rfunction::unionOf(f1, f2, alpha);
+}
+
+double rIntersection(double f1, double f2, double alpha)
+{
+  return rfunction::intersectionOf(f1, f2, alpha);
+}
+
+Expr hyperFunIntersection(const Expr& f1, const Expr& f2, double alpha)
+{
+  return rfunction::sumMinusRoot(f1, f2, alpha);
+}
 
 Shape unite(const Shape& a, const Shape& b, double alpha)
 {

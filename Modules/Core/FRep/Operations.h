@@ -24,6 +24,19 @@ namespace ictk::frep
 /// f1 + f2 +- sqrt(f1^2 + f2^2); alpha = 1 is exactly max / min (L614-L616).
 Shape unite(const Shape& a, const Shape& b, double alpha = 0.0);
 Shape intersect(const Shape& a, const Shape& b, double alpha = 0.0);
+/// The R-functions themselves on fields' values, what unite and intersect build (and the
+/// HyperFun and BlobTree front ends), alpha in (-1, 1], as Exprs or doubles (one formula). They
+/// are computed without the cancellation of f1 + f2 + r (r the square root) where f1 + f2 < 0:
+/// there the union is the same number as -2 (1 + alpha) f1 f2 / (r - f1 - f2) / (1 + alpha),
+/// which keeps the nearer operand next to a far one (f1 = -1e8, f2 = 1e-9: about 1e-9, where the
+/// sum gives 0); the intersection likewise where f1 + f2 > 0.
+Expr rUnion(const Expr& f1, const Expr& f2, double alpha = 0.0);
+Expr rIntersection(const Expr& f1, const Expr& f2, double alpha = 0.0);
+double rUnion(double f1, double f2, double alpha = 0.0);
+double rIntersection(double f1, double f2, double alpha = 0.0);
+/// hfBlock.c's unnormalised R-intersection f1 + f2 - sqrt(f1^2 + f2^2 - 2 alpha f1 f2), that is
+/// (1 + alpha) rIntersection(f1, f2, alpha) for alpha != 1, computed the same way.
+Expr hyperFunIntersection(const Expr& f1, const Expr& f2, double alpha);
 /// a \ b = a intersect_alpha (-b) (thesis_ch2_3.md 1.7 [EXT]).
 Shape subtract(const Shape& a, const Shape& b, double alpha = 0.0);
 /// C^m R-functions (Pasko & Savchenko 1994; thesis_ch2_3.md 1.7 [EXT]; replaces the garbled

@@ -3,6 +3,7 @@
 // (repository pmur002/hyperfun, src/hflibrary_lib/hf*.c); where those are wrong or fragile the
 // comment says what differs and why. Every field is an Expr, so every evaluator supports it.
 #include "FRep/Primitives.h"
+#include "FRep/Operations.h"
 #include "FRep/ParameterChecks.h"
 #include "FRep/Vector.h"
 
@@ -459,13 +460,6 @@ Slabs blockSlabs(const char* primitive, const Vec3& vertex, double dx, double dy
     (z - vertex[2]) * ((vertex[2] + dz) - z) };
 }
 
-/// hfBlock.c's R-intersection: f1 + f2 - sqrt(f1^2 + f2^2 - 2 alpha f1 f2) (no 1/(1+alpha)).
-/// The radicand is (f1 - alpha f2)^2 + (1 - alpha^2) f2^2 >= 0, but can round below 0 when
-/// f1 ~ f2 and alpha ~ 1, hence the max.
-Expr hyperFunIntersection(const Expr& f1, const Expr& f2, double alpha)
-{
-  return f1 + f2 - sqrt(max(0.0, square(f1) + square(f2) - (2.0 * alpha) * f1 * f2));
-}
 } // namespace
 
 // hfBlock.c with ALPHA = 1: the min of the three slab functions.

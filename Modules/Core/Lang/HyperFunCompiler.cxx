@@ -255,13 +255,13 @@ Val Compiler::eval(Frame& f, int index)
 
 Expr Compiler::rUnion(const Expr& a, const Expr& b)
 {
-  // = frep::unite(alpha 0) (Operations.cxx rUnion), HyperFun FUNC_binary_union with ALPHA = 0.
-  return a + b + frep::sqrt(frep::square(a) + frep::square(b));
+  // = frep::unite(alpha 0), HyperFun FUNC_binary_union with ALPHA = 0.
+  return frep::rUnion(a, b);
 }
 
 Expr Compiler::rIntersection(const Expr& a, const Expr& b)
 {
-  return a + b - frep::sqrt(frep::square(a) + frep::square(b));
+  return frep::rIntersection(a, b);
 }
 
 Val Compiler::binary(TokenKind op, const Val& a, const Val& b, const ExprNode& at)

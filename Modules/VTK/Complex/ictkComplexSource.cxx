@@ -187,6 +187,12 @@ std::string readFailure(
   {
     return e.substr(stl.size());
   }
+  // vtkXMLUnstructuredDataReader: a piece without its <Points> element, which VTK's writers
+  // leave out of a grid that has no points object, and VTK follows with "Reading file may fail".
+  if (e.rfind("No Points element", 0) == 0)
+  {
+    return "it has no points";
+  }
   if (e.rfind("Error reading extent", 0) == 0)
   {
     return "its data is cut short or corrupt (" + e + ")";
@@ -282,12 +288,23 @@ vtkSmartPointer<Reader> readWith(const std::string& path, const std::string& for
   return reader;
 }
 
+} // namespace
+
+vtkSmartPointer<vtkUnstructuredGrid> ictk::vtk::readUnstructuredGrid(const std::string& path)
+{
+  return readWith<vtkXMLUnstructuredGridReader>(path, "UnstructuredGrid")->GetOutput();
+}
+
+namespace
+{
+using namespace ictk;
+
 complex::ExplicitGeometry readMesh(const std::string& path)
 {
   vtkSmartPointer<vtkDataSet> data;
   if (endsWith(path, ".vtu"))
   {
-    data = readWith<vtkXMLUnstructuredGridReader>(path, "UnstructuredGrid")->GetOutput();
+    data = ictk::vtk::readUnstructuredGrid(path);
   }
   else if (endsWith(path, ".vtp"))
   {

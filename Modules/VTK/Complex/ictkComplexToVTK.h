@@ -24,9 +24,12 @@
 
 #include <vector>
 
+#include <string>
+
 class vtkDataAssembly;
 class vtkMultiBlockDataSet;
 class vtkPartitionedDataSetCollection;
+class vtkUnstructuredGrid;
 
 namespace ictk
 {
@@ -58,6 +61,13 @@ ICTKFILTERSCOMPLEX_EXPORT vtkSmartPointer<vtkDataAssembly> complexAssembly(
 /// collections (.vtm files).
 ICTKFILTERSCOMPLEX_EXPORT void complexToMultiBlock(
   vtkPartitionedDataSetCollection* input, vtkMultiBlockDataSet* output);
+
+/// A VTK XML unstructured grid (.vtu) read the one way ICTK reads them: a complex's mesh cells
+/// (ictkComplexSource), `ictk render` and `ictk solve`. VTK's own reports are caught, not printed;
+/// a file that cannot be read throws std::invalid_argument, one line naming the file and what
+/// was wrong ("cannot read 'bar.vtu': it has no points").
+ICTKFILTERSCOMPLEX_EXPORT vtkSmartPointer<vtkUnstructuredGrid> readUnstructuredGrid(
+  const std::string& path);
 
 } // namespace vtk
 } // namespace ictk
