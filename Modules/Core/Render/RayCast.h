@@ -29,10 +29,11 @@
 //      could only have confirmed that): a sign change is refined by Illinois
 //      (FRep/RootFinding.h refineRoot) to the depth tolerance; two negative ends are checked by
 //      the leaf's interval, and one that does not exclude 0 means a feature may hide inside, so
-//      the leaf is halved again (samples and intervals) down to the depth tolerance. The evaluators are
-//      incremental (FRep/Evaluators.h): successive pieces of one ray differ in z alone when the
-//      rays are parallel to z (an orthographic view along it), and then only the instructions
-//      that depend on z run again; the values are those of a full evaluation, bit for bit.
+//      the leaf is halved again (samples and intervals) down to the depth tolerance. The
+//      evaluators are incremental (FRep/Evaluators.h): successive pieces of one ray differ in z
+//      alone when the rays are parallel to z (an orthographic view along it), and then only the
+//      instructions that depend on z run again; the values are those of a full evaluation, bit
+//      for bit.
 //   4. The hit is shaded from the analytic gradient (Lambert with an ambient term, lit by a
 //      headlight, both faces lit) in the model's colour (see RayCastOptions).
 //
