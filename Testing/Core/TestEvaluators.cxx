@@ -661,6 +661,25 @@ TEST(Evaluators, PruningCutsTheLosingBranchOfAUnion)
   EXPECT_DOUBLE_EQ(p.eval(2, 0, 0), 1.0);
 }
 
+TEST(Evaluators, AProductOfAValueWithItselfIsBoundedAsASquare)
+{
+  // 1 - (x x + y y + z z), a ball written with products: over [-1, 2] x [-0.5, 0.5] x [0, 0] the
+  // sum of squares lies in [0, 4.25], so f in [-3.25, 1]. Bounded as products of independent
+  // factors, x x would reach down to -2 and y y to -0.25, and f up to 3.25.
+  const Expr x = Expr::x(), y = Expr::y(), z = Expr::z();
+  const TapePtr tape = Tape::compile(Expr(1.0) - (x * x + y * y + z * z));
+  IntervalEvaluator interval(tape);
+  Region region;
+  region.axes = { Interval{ -1, 2 }, Interval{ -0.5, 0.5 }, Interval{ 0, 0 }, Interval{ 0, 0 } };
+  const Interval r = interval.eval(region);
+  EXPECT_NEAR(r.lo, -3.25, 1e-12);
+  EXPECT_NEAR(r.hi, 1.0, 1e-12);
+  // The point values are the products', bit for bit.
+  PointEvaluator p(tape);
+  for (const double v : { -1.0, 0.3, 1.7, 1e-200, 3e150 })
+    EXPECT_EQ(p.eval(v, 0, 0), 1.0 - (v * v + 0.0 * 0.0 + 0.0 * 0.0));
+}
+
 TEST(Evaluators, MultipleOutputsAndParameters)
 {
   const Expr r = Expr::parameter(0);

@@ -158,6 +158,14 @@ TapePtr Tape::compile(const std::vector<Expr>& outputs)
         {
           *operands[k] = valueOf.at(e.child(k).id());
         }
+        if (ins.op == Opcode::Mul && ins.a == ins.b)
+        {
+          // a * a evaluated as Square: the same product in IEEE arithmetic, but its interval is
+          // that of a square, >= 0, where two independent factors over an interval around 0 are
+          // bounded below by -|lo| hi (a sphere written x * x + y * y + z * z excludes nothing
+          // next to the axes). The model keeps the product as written (its XML, its HyperFun).
+          ins = { Opcode::Square, ins.a, 0, 0 };
+        }
         v = leafCount + static_cast<std::uint32_t>(ssa.size());
         ssa.push_back(ins);
       }
