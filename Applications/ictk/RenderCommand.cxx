@@ -565,6 +565,11 @@ private:
     o.times = std::move(times);
     o.discretization.featureSize = this->FeatureSize;
     o.discretization.threads = this->Threads;
+    if (this->Mode != "mesh")
+    {
+      // The solids given by fields are ray cast: their surfaces would be meshed for nothing.
+      o.cells = render::meshedCells;
+    }
     return o;
   }
 

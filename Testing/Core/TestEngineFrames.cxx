@@ -146,3 +146,40 @@ TEST(FrameSequence, SharesCellsAmongPiecesAndStartsAgainAfterACancel)
   EXPECT_EQ(Points(f.mesh), Points(all.mesh));
   EXPECT_EQ(f.instance, "K3");
 }
+
+// FrameSequenceOptions::cells: only the cells it picks are discretised (ictk render asks for the
+// ones it does not ray cast), within the share of a piece; the others have no mesh.
+TEST(FrameSequence, DiscretisesTheCellsTheOptionsPick)
+{
+  engine::FrameSequence whole(DiskRectangle(), DiskOptions());
+  const engine::Frame all = whole.frame(10);
+  ASSERT_EQ(all.mesh.cells.size(), 7u);
+
+  engine::FrameSequenceOptions options = DiskOptions();
+  options.cells = [](const ictk::complex::Complex& complex)
+  {
+    std::vector<ictk::complex::CellId> even;
+    for (std::size_t i = 0; i < complex.cellIds().size(); i += 2)
+    {
+      even.push_back(complex.cellIds()[i]);
+    }
+    return even;
+  };
+  engine::FrameSequence picked(DiskRectangle(), options);
+  const engine::Frame f = picked.frame(10);
+  EXPECT_EQ(f.complex->cellCount(), 7u);
+  EXPECT_EQ(f.mesh.cells.size(), 4u);
+  // The same cells as piece 0 of 2 (cell i goes to piece i mod 2), with the same points.
+  engine::FrameSequence part(DiskRectangle(), DiskOptions());
+  EXPECT_EQ(Points(f.mesh), Points(part.frame(10, { 0, 2 }).mesh));
+  // Piece 1 of 2 has none of the even cells.
+  engine::FrameSequence other(DiskRectangle(), options);
+  EXPECT_TRUE(other.frame(10, { 1, 2 }).mesh.cells.empty());
+
+  options.cells = [](const ictk::complex::Complex&)
+  {
+    return std::vector<ictk::complex::CellId>{};
+  };
+  engine::FrameSequence none(DiskRectangle(), options);
+  EXPECT_TRUE(none.frame(10).mesh.cells.empty());
+}

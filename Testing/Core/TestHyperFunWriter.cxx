@@ -42,7 +42,8 @@ frep::Hypervolume shape(const Expr& f, Domain d = Domain::XYZ)
 // A random DAG using every opcode but with finite constants only (HyperFun cannot write NaN or
 // infinities), Pow only with a non-constant exponent (a constant integer exponent reads back
 // through frep::pow as a product of squares, a different node) and Div only by a non-constant
-// (HyperFun refuses a constant divisor below 1e-6).
+// (HyperFun refuses a constant divisor below 1e-6), CauchySegment only of a square (its terms take
+// sqrt(1 + v)).
 Expr randomDag(std::mt19937& rng, int size, Domain domain, int params)
 {
   std::vector<Expr> pool;
@@ -90,8 +91,18 @@ Expr randomDag(std::mt19937& rng, int size, Domain domain, int params)
         break;
       }
       default:
-        e = Expr::make(op, pick(), pick(), pick());
+      {
+        const Expr& a = pick();
+        Expr b = pick();
+        // The Cauchy segment's second operand is a squared distance: HyperFun refuses the
+        // square root of a negative constant that its terms would take otherwise.
+        if (op == Opcode::CauchySegment)
+        {
+          b = frep::square(b);
+        }
+        e = Expr::make(op, a, b, pick());
         break;
+      }
     }
     if (e.isConstant() && !std::isfinite(e.constantValue()))
     {

@@ -230,6 +230,13 @@ TEST_P(JitTest, EveryOpcodeMatchesTheInterpreterBitForBit)
   expectSame(Tape::compile(select(y, x, z)), points, lo, hi, "select(y, x, z)");
   expectSame(Tape::compile(select(x - z, Expr(2.0), y * x)), points, lo, hi, "select(x-z, 2, yx)");
   expectSame(Tape::compile(select(z, x, Expr(-1.0))), points, lo, hi, "select(z, x, -1)");
+  // The Cauchy segment's kernel, with its length uniform along the row (y), constant or varying.
+  const Expr u = Expr::make(Opcode::CauchySegment, x, square(z), y);
+  expectSame(Tape::compile(u), points, lo, hi, "cauchySegment(x, z^2, y)");
+  expectSame(Tape::compile(Expr::make(Opcode::CauchySegment, x, square(x - z), Expr(1.5))), points,
+    lo, hi, "cauchySegment(x, (x-z)^2, 1.5)");
+  expectSame(Tape::compile(Expr::make(Opcode::CauchySegment, y, square(x), x + z)), points, lo, hi,
+    "cauchySegment(y, x^2, x+z)");
 }
 
 TEST_P(JitTest, RandomTreesMatchTheInterpreterBitForBit)

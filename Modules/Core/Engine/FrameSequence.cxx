@@ -224,17 +224,20 @@ Frame FrameSequence::at(double t, const CellShare& share)
     const std::vector<CellState> cells = in.model->cells();
     f.complex = std::make_shared<const complex::Complex>(in.model->complex());
     const int pieces = std::max(1, share.pieces);
-    if (pieces == 1)
+    if (pieces == 1 && !in.options.cells)
     {
       f.mesh = in.mesher->discretize(cells, *f.complex);
     }
     else
     {
       const std::vector<complex::CellId> all = f.complex->cellIds();
+      const std::vector<complex::CellId> picked =
+        in.options.cells ? in.options.cells(*f.complex) : all;
       std::vector<complex::CellId> mine;
       for (std::size_t i = 0; i < all.size(); ++i)
       {
-        if (static_cast<int>(i % static_cast<std::size_t>(pieces)) == share.piece)
+        if (static_cast<int>(i % static_cast<std::size_t>(pieces)) == share.piece &&
+          std::find(picked.begin(), picked.end(), all[i]) != picked.end())
         {
           mine.push_back(all[i]);
         }

@@ -62,6 +62,11 @@ struct FrameSequenceOptions
   /// the sequence's own. A feature size of 0 is fixed from the complex at the model's start,
   /// whatever frame is asked for first.
   CoherenceOptions discretization;
+  /// The cells of a frame's complex to discretise (of the share's); empty: every cell. A renderer
+  /// that ray casts the solids given by fields asks for the others only
+  /// (Render/ComplexRender.h meshedCells): the surface of a 3D field cell it never draws from its
+  /// mesh is the most expensive part of a frame's discretisation.
+  std::function<std::vector<complex::CellId>(const complex::Complex&)> cells;
   /// Progress of one frame: the engine's run to it in [0, 0.5], its discretisation in [0.5, 1];
   /// false cancels (ictk::Cancelled; the next frame starts the model again).
   Progress progress;
@@ -85,7 +90,8 @@ struct Frame
   std::vector<FrameRecord> records;
   /// The active instance's complex; its cell ids follow the instance's cells.
   std::shared_ptr<const complex::Complex> complex;
-  /// The coherent discretisation of the share's cells (every cell for one piece).
+  /// The coherent discretisation of the share's cells (every cell for one piece) that
+  /// FrameSequenceOptions::cells picks.
   complex::ComplexMesh mesh;
 };
 

@@ -509,6 +509,41 @@ Interval trigRange(bool isSin, const Interval& a)
   return { std::max(r.lo, -1.0), std::min(r.hi, 1.0), r.maybeNaN };
 }
 
+// Bounds that are finite and ordered, with no NaN: what nearly every instruction of a model sees
+// over a box inside its domain.
+inline bool plain(const Interval& a)
+{
+  return !a.maybeNaN && a.lo >= -std::numeric_limits<double>::max() &&
+    a.hi <= std::numeric_limits<double>::max() && a.lo <= a.hi;
+}
+
+// Opcode::CauchySegment over a box of operands (u, v, length), by its monotony rather than by its
+// terms: the integral of k(tau) = 1 / (1 + v + tau^2)^2 over [-u, length - u] decreases in v
+// (the integrand does) and increases in the length (the integrand is positive); its derivative in
+// u is k(u) - k(length - u), positive while |u| < |length - u|, so for a length >= 0 it rises up
+// to u = length / 2 and falls after. The largest value is at the smallest v, the largest length
+// and the u nearest half of it; the smallest at the largest v, the smallest length and an end of
+// u's interval. Those corners are computed as the point evaluators compute any point, so the
+// bound is widened by twice the rounding error a point can have: the four terms of Kernels.h add
+// up to at most (1/2 + pi/2) / P^3 in magnitude (P^2 = 1 + v >= 1), and each is computed to
+// within about 30 ulps of itself (a dozen roundings, sqrt, atan within an ulp, P's error tripled
+// by P^3), so 256 ulps of 2.1 / P^3 each side hold the point values with room to spare. Operands
+// outside the kernel's use (v < 0, a negative length, NaN, infinities) get no bound.
+Interval cauchySegmentRange(const Interval& u, const Interval& v, const Interval& length)
+{
+  if (u.empty() || v.empty() || length.empty())
+    return nowhere();
+  if (!plain(u) || !plain(v) || !plain(length) || v.lo < 0 || length.lo < 0)
+    return { -inf, inf, true };
+  const double top = std::clamp(0.5 * length.hi, u.lo, u.hi);
+  const double largest = detail::cauchySegment(top, v.lo, length.hi);
+  const double smallest = std::min(
+    detail::cauchySegment(u.lo, v.hi, length.lo), detail::cauchySegment(u.hi, v.hi, length.lo));
+  const double p2 = 1 + v.lo;
+  const double error = 256 * std::numeric_limits<double>::epsilon() * 2.1 / (p2 * std::sqrt(p2));
+  return { nextDown(smallest - error), nextUp(largest + error), false };
+}
+
 // The interval counterpart of each opcode. Choices mirror the point semantics exactly, including
 // NaN: minOp(a, b) and maxOp(a, b) return a whenever either operand is NaN, and select takes its
 // second branch when the condition is NaN; so deciding for the first operand is always safe, and
@@ -579,6 +614,8 @@ Interval intervalOp(
       if (a.empty() || b.empty() || a.maybeNaN || b.maybeNaN)
         return { -inf, inf, true };
       break;
+    case Opcode::CauchySegment:
+      return cauchySegmentRange(a, b, c);
     default:
       break;
   }
@@ -695,14 +732,6 @@ Interval intervalOp(
     default:
       return { -inf, inf, true };
   }
-}
-
-// Bounds that are finite and ordered, with no NaN: what nearly every instruction of a model sees
-// over a box inside its domain.
-inline bool plain(const Interval& a)
-{
-  return !a.maybeNaN && a.lo >= -std::numeric_limits<double>::max() &&
-    a.hi <= std::numeric_limits<double>::max() && a.lo <= a.hi;
 }
 
 // mul() of plain operands: finite products, so no NaN and no zero times infinity.
@@ -1152,6 +1181,27 @@ ValueGradient gradientOp(
     }
     case Opcode::Select:
       return x >= 0 ? chain(v, b, 1) : chain(v, c, 1);
+    case Opcode::CauchySegment:
+    {
+      // d/du = k(u) - k(length - u), d/dlength = k(length - u) with k(tau) = 1 / (P^2 + tau^2)^2;
+      // d/dv = -2 (H(u) + H(length - u)), H the odd antiderivative of 1 / (P^2 + tau^2)^3:
+      // H(tau) = tau / (4 P^2 (P^2 + tau^2)^2) + 3 tau / (8 P^4 (P^2 + tau^2))
+      //   + 3 atan(tau / P) / (8 P^5).
+      const double p2 = 1 + y, p = std::sqrt(p2), w = c.value - x;
+      const auto k = [&](double tau)
+      {
+        const double q = p2 + tau * tau;
+        return 1 / (q * q);
+      };
+      const auto h = [&](double tau)
+      {
+        const double q = p2 + tau * tau;
+        return tau / (4 * p2 * q * q) + 3 * tau / (8 * p2 * p2 * q) +
+          3 * std::atan(tau / p) / (8 * p2 * p2 * p);
+      };
+      ValueGradient r = combine(v, a, k(x) - k(w), b, -2 * (h(x) + h(w)));
+      return combine(v, r, 1, c, k(w));
+    }
     default:
       return chain(v, a, 0);
   }

@@ -30,7 +30,7 @@ constexpr OpcodeInfo opcodeTable[] = {
   { "square", 1 }, { "exp", 1 }, { "log", 1 }, { "sin", 1 }, { "cos", 1 }, { "tan", 1 },
   { "asin", 1 }, { "acos", 1 }, { "atan", 1 }, { "sign", 1 }, { "floor", 1 }, { "add", 2 }, { "sub", 2 },
   { "mul", 2 }, { "div", 2 }, { "min", 2 }, { "max", 2 }, { "pow", 2 }, { "atan2", 2 },
-  { "select", 3 },
+  { "select", 3 }, { "cauchySegment", 3 },
 };
 // clang-format on
 static_assert(sizeof(opcodeTable) / sizeof(opcodeTable[0]) == static_cast<int>(Opcode::Count_),
@@ -43,6 +43,30 @@ std::uint64_t doubleBits(double v)
   return bits;
 }
 } // namespace
+
+namespace
+{
+template <typename T>
+T cauchySegmentTerms(T u, T v, T length)
+{
+  const T p2 = T(1) + v;
+  const T p = std::sqrt(p2);
+  const T w = length - u;
+  const T rational = u / (T(2) * p2 * (p2 + u * u)) + w / (T(2) * p2 * (p2 + w * w));
+  const T angular = (std::atan(u / p) + std::atan(w / p)) / (T(2) * p2 * p);
+  return rational + angular;
+}
+} // namespace
+
+double detail::cauchySegment(double u, double v, double length)
+{
+  return cauchySegmentTerms(u, v, length);
+}
+
+float detail::cauchySegment(float u, float v, float length)
+{
+  return cauchySegmentTerms(u, v, length);
+}
 
 const char* axisName(Axis a)
 {
@@ -435,6 +459,15 @@ Expr Expr::make(Opcode op, const Expr& a, const Expr& b)
 
 Expr Expr::make(Opcode op, const Expr& a, const Expr& b, const Expr& c)
 {
+  if (op == Opcode::CauchySegment)
+  {
+    if (a.isConstant() && b.isConstant() && c.isConstant())
+    {
+      return constant(
+        detail::cauchySegment(a.constantValue(), b.constantValue(), c.constantValue()));
+    }
+    return Node::intern(op, 0, { a, b, c });
+  }
   if (op != Opcode::Select)
   {
     throw std::logic_error(std::string("Expr::make: ") + opcodeName(op) + " is not ternary");
@@ -610,8 +643,8 @@ double evaluateReference(
             n.opcode(), values.at(n.child(0).id()), values.at(n.child(1).id()), 0.0);
           break;
         default:
-          v = values.at(n.child(0).id()) >= 0 ? values.at(n.child(1).id())
-                                              : values.at(n.child(2).id());
+          v = detail::applyScalar<double>(n.opcode(), values.at(n.child(0).id()),
+            values.at(n.child(1).id()), values.at(n.child(2).id()));
           break;
       }
       values.emplace(n.id(), v);

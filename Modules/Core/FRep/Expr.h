@@ -64,6 +64,14 @@ enum class Opcode : std::uint8_t
 
   // ternary
   Select, ///< a >= 0 ? b : c
+          /// The Cauchy kernel 1 / (1 + b + tau^2)^2 integrated over tau in [-a, c - a]: a segment
+          /// of length c / s along a convolution skeleton, seen from a point at s^2 b squared
+          /// distance from its line and at a / s along it from its start, gives this / s
+          /// (Primitives.h cauchySegmentField). One opcode so that its interval bound is tight: it
+          /// decreases in b, increases in c, and rises in a up to c / 2 and falls after, so the
+          /// extremes over a box of operands are at known corners, where the sum of its terms
+          /// bounds them far too loosely.
+  CauchySegment,
   Count_
 };
 

@@ -28,6 +28,17 @@ inline T signOp(T a)
   return a > T(0) ? T(1) : (a < T(0) ? T(-1) : T(0));
 }
 
+/// Opcode::CauchySegment: the integral of 1 / (1 + v + tau^2)^2 over tau in [-u, length - u],
+/// with P^2 = 1 + v and w = length - u,
+///   u / (2 P^2 (P^2 + u^2)) + w / (2 P^2 (P^2 + w^2)) + (atan(u / P) + atan(w / P)) / (2 P^3).
+/// For v >= 0 the four terms add up to at most (1/2 + pi/2) / P^3 in magnitude, which bounds the
+/// rounding error (the interval evaluator widens by it). Out of line (Expr.cxx), compiled once
+/// for the baseline instruction set: inlined into the batch kernels that are also compiled for
+/// FMA, its products and sums would be fused there and differ from the point values in the last
+/// bits.
+double cauchySegment(double u, double v, double length);
+float cauchySegment(float u, float v, float length);
+
 template <typename T>
 inline T applyScalar(Opcode op, T a, T b, T c)
 {
@@ -79,6 +90,8 @@ inline T applyScalar(Opcode op, T a, T b, T c)
       return std::atan2(a, b);
     case Opcode::Select:
       return a >= T(0) ? b : c;
+    case Opcode::CauchySegment:
+      return cauchySegment(a, b, c);
     default:
       return T(0);
   }

@@ -183,7 +183,12 @@ Expr pointField(const char* primitive, const std::string& what, const Vec3& c, d
 //     = [u / (2 P^2 (P^2 + s^2 u^2)) + atan(s u / P) / (2 s P^3)]_{-x}^{l-x},
 // with P^2 + s^2 x^2 = 1 + s^2 |p - b|^2 and P^2 + s^2 (l - x)^2 = 1 + s^2 |p - e|^2. This is
 // hfConvLine.c's expression; ICTK takes |d x a|^2 instead of |d|^2 - x^2 so that P^2 cannot round
-// below 1. Every denominator is >= 1, so the field has no singular point.
+// below 1. Every denominator is >= 1, so the field has no singular point. Substituting s u, it is
+// 1/s times the kernel's integral in the dimensionless s x, s^2 |d x a|^2 and s l, one opcode
+// (Opcode::CauchySegment) whose interval bound over a box is tight: written out, x, l - x and P
+// each occur in several terms of opposite trends, and intervals over a box many times the
+// kernel's width bound it by orders of magnitude more than its range, so a sum of segments far
+// away (a stand-in, Skin/StandIn.h) could not be shown negative there.
 Expr segmentField(
   const char* primitive, const std::string& what, const Vec3& b, const Vec3& e, double s)
 {
@@ -713,16 +718,8 @@ Expr cauchySegmentField(
   const Expr l = sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
   const Expr inverseLength = Expr(1.0) / l;
   const EVec a{ axis.x * inverseLength, axis.y * inverseLength, axis.z * inverseLength };
-  const Expr s2 = s * s;
   const EVec d = fromPoint(begin);
-  const Expr x = dot(d, a);
-  const Expr p2 = 1.0 + s2 * crossNorm2(d, a);
-  const Expr p = sqrt(p2);
-  const Expr toBegin = 1.0 + s2 * norm2(d);
-  const Expr toEnd = 1.0 + s2 * norm2(fromPoint(end));
-  const Expr rational = x / (2.0 * p2 * toBegin) + (l - x) / (2.0 * p2 * toEnd);
-  const Expr angular = (atan(s * x / p) + atan(s * (l - x) / p)) / ((2.0 * s) * p2 * p);
-  return rational + angular;
+  return Expr::make(Opcode::CauchySegment, s * dot(d, a), (s * s) * crossNorm2(d, a), s * l) / s;
 }
 
 Expr cauchyArcField(

@@ -7,12 +7,12 @@
 namespace ictk::frep::detail
 {
 
-/// opcodeArity, inline (the enumeration is ordered: leaves, unary, binary, select).
+/// opcodeArity, inline (the enumeration is ordered: leaves, unary, binary, ternary).
 inline int arity(Opcode op)
 {
   if (op >= Opcode::Add)
   {
-    return op == Opcode::Select ? 3 : 2;
+    return op >= Opcode::Select ? 3 : 2;
   }
   return op >= Opcode::Neg ? 1 : 0;
 }

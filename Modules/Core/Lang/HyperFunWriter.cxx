@@ -422,6 +422,23 @@ private:
       return;
     }
 
+    if (e.opcode() == Opcode::CauchySegment)
+    {
+      // HyperFun has no such function: the kernel's terms (FRep/Kernels.h cauchySegment), over
+      // locals since each operand occurs several times.
+      const std::string u = atomOf(e.child(0)), v = atomOf(e.child(1)), l = atomOf(e.child(2));
+      const std::string p2 = "v" + std::to_string(++localCount_);
+      const std::string p = "v" + std::to_string(++localCount_);
+      const std::string w = "v" + std::to_string(++localCount_);
+      body_ += "  " + p2 + " = 1 + " + v + ";\n  " + p + " = sqrt(" + p2 + ");\n  " + w + " = " +
+        l + " - " + u + ";\n";
+      const std::string r = newLocal(e);
+      body_ += "  " + r + " = " + u + " / (2 * " + p2 + " * (" + p2 + " + " + u + "^2)) + " + w +
+        " / (2 * " + p2 + " * (" + p2 + " + " + w + "^2)) + (atan(" + u + " / " + p + ") + atan(" +
+        w + " / " + p + ")) / (2 * " + p2 + " * " + p + ");\n";
+      return;
+    }
+
     if (e.arity() == 1)
     {
       const Text c = take(e.child(0));
@@ -477,6 +494,24 @@ private:
       return;
     }
     texts_.emplace(e.id(), std::move(t));
+  }
+
+  // A child's text as an atom that may be repeated: a leaf or a local as it is, a negative
+  // number bracketed, anything else through a local of its own.
+  std::string atomOf(const Expr& e)
+  {
+    const Text t = take(e);
+    if (t.precedence == Atom)
+    {
+      return t.text;
+    }
+    if (e.isConstant())
+    {
+      return "(" + t.text + ")";
+    }
+    const std::string v = "v" + std::to_string(++localCount_);
+    body_ += "  " + v + " = " + t.text + ";\n";
+    return v;
   }
 
   std::string newLocal(const Expr& e)
