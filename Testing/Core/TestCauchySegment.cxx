@@ -7,6 +7,8 @@
 #include "FRep/Kernels.h"
 #include "FRep/Primitives.h"
 
+#include "PortableRandom.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,20 +23,7 @@ using namespace ictk::frep;
 
 namespace
 {
-// A portable uniform mapping (std::uniform_real_distribution differs between standard libraries).
-struct Random
-{
-  explicit Random(unsigned seed)
-    : engine(seed)
-  {
-  }
-  double uniform(double lo, double hi)
-  {
-    return lo + (hi - lo) * (static_cast<double>(engine() >> 11) * 0x1.0p-53);
-  }
-  Vec3 point(double lo, double hi) { return { uniform(lo, hi), uniform(lo, hi), uniform(lo, hi) }; }
-  std::mt19937_64 engine;
-};
+using Random = ictk::fixtures::PortableRandom;
 
 // The segment field as it was written before the opcode (hfConvLine's terms in x, y, z): the
 // same function, whose interval bound is the sum of its terms' bounds.

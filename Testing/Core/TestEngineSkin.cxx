@@ -792,15 +792,22 @@ TEST(EngineSkeleton, TheMeshesKeepTheirTopologyOutsideTheMorph)
   std::printf("target: V %zu E %zu F %zu, chi %ld, %zu components, %zu boundary edges\n",
     target.vertices, target.edges, target.triangles, target.eulerCharacteristic, target.components,
     target.boundaryEdges);
-  for (const double t : { 0.5, 1.0, 1.25, 1.45 })
+  // The mesh of `cell` at each of `times`, all in the instances `a` or `b`, is `file`'s.
+  auto expectKept = [&](const char* cell, const skin::SkinnedMesh& file,
+                      const ictk::discretize::MeshTopology& bind,
+                      std::initializer_list<double> times, const char* a, const char* b)
   {
-    m.advanceTo(t, 0.25);
-    ASSERT_TRUE(m.activeInstance() == "K1" || m.activeInstance() == "K2") << t;
-    const auto got = topologyOf("Source", x.source, "t " + std::to_string(t));
-    EXPECT_EQ(got.eulerCharacteristic, source.eulerCharacteristic) << t;
-    EXPECT_EQ(got.edges, source.edges) << t;
-    EXPECT_EQ(got.components, source.components) << t;
-  }
+    for (const double t : times)
+    {
+      m.advanceTo(t, 0.25);
+      ASSERT_TRUE(m.activeInstance() == a || m.activeInstance() == b) << t;
+      const auto got = topologyOf(cell, file, "t " + std::to_string(t));
+      EXPECT_EQ(got.eulerCharacteristic, bind.eulerCharacteristic) << t;
+      EXPECT_EQ(got.edges, bind.edges) << t;
+      EXPECT_EQ(got.components, bind.components) << t;
+    }
+  };
+  expectKept("Source", x.source, source, { 0.5, 1.0, 1.25, 1.45 }, "K1", "K2");
   // K3: the Morph's surface, by dual contouring in its box with cells of 0.2.
   auto morphTopology = [&](const engine::DynamicModel& model, const std::string& when)
   {
@@ -833,15 +840,7 @@ TEST(EngineSkeleton, TheMeshesKeepTheirTopologyOutsideTheMorph)
   const auto last = morphTopology(m, "t 3.75");
   EXPECT_EQ(last.eulerCharacteristic, target.eulerCharacteristic);
   EXPECT_EQ(last.components, target.components);
-  for (const double t : { 4.0, 4.25, 4.75, 5.5 })
-  {
-    m.advanceTo(t, 0.25);
-    ASSERT_TRUE(m.activeInstance() == "K4" || m.activeInstance() == "K5") << t;
-    const auto got = topologyOf("Target", x.target, "t " + std::to_string(t));
-    EXPECT_EQ(got.eulerCharacteristic, target.eulerCharacteristic) << t;
-    EXPECT_EQ(got.edges, target.edges) << t;
-    EXPECT_EQ(got.components, target.components) << t;
-  }
+  expectKept("Target", x.target, target, { 4.0, 4.25, 4.75, 5.5 }, "K4", "K5");
 }
 
 // T-5.5 item 5 in the model: with the weight map sourceTop the vertices of the higher z (in the

@@ -6,6 +6,8 @@
 #include "FRep/Sampling.h"
 #include "FRep/SinCos.h"
 
+#include "PortableRandom.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,20 +23,7 @@ using namespace ictk::frep;
 
 namespace
 {
-// A portable uniform mapping (std::uniform_real_distribution differs between standard libraries).
-struct Random
-{
-  explicit Random(unsigned seed)
-    : engine(seed)
-  {
-  }
-  double uniform(double lo, double hi)
-  {
-    return lo + (hi - lo) * (static_cast<double>(engine() >> 11) * 0x1.0p-53);
-  }
-  int index(int n) { return static_cast<int>(engine() % static_cast<std::uint64_t>(n)); }
-  std::mt19937_64 engine;
-};
+using Random = ictk::fixtures::PortableRandom;
 
 // Sample s of a region: its low corner, its high corner, then random points inside.
 template <typename Region>

@@ -9,6 +9,8 @@
 #include "FRep/Render.h"
 #include "Lang/VmReader.h"
 
+#include "PortableRandom.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,19 +35,7 @@ std::filesystem::path benchModels()
   return ICTK_BENCH_MODELS_DIR;
 }
 
-struct Random
-{
-  explicit Random(unsigned seed)
-    : engine(seed)
-  {
-  }
-  double uniform(double lo, double hi)
-  {
-    return lo + (hi - lo) * (static_cast<double>(engine() >> 11) * 0x1.0p-53);
-  }
-  int index(int n) { return static_cast<int>(engine() % static_cast<std::uint64_t>(n)); }
-  std::mt19937_64 engine;
-};
+using Random = ictk::fixtures::PortableRandom;
 
 const Opcode unaryOps[] = { Opcode::Neg, Opcode::Abs, Opcode::Sqrt, Opcode::Square, Opcode::Exp,
   Opcode::Log, Opcode::Sin, Opcode::Cos, Opcode::Tan, Opcode::Asin, Opcode::Acos, Opcode::Atan,

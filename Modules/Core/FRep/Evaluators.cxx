@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 namespace ictk::frep
 {
@@ -1027,19 +1028,7 @@ Interval IncrementalIntervalEvaluator::eval(const Region& region)
     values_[ins.out] =
       fastIntervalOp(ins.op, values_[ins.a], values_[ins.b], values_[ins.c], choices_[i]);
   };
-  if (first_)
-  {
-    // The first eval also computes the instructions of constants and parameters alone.
-    first_ = false;
-    for (std::size_t i = 0; i < code.size(); ++i)
-    {
-      run(i);
-    }
-  }
-  else
-  {
-    ssa_.forEachDependent(changed, run);
-  }
+  ssa_.forEachDependent(changed, std::exchange(first_, false), run);
   return values_[ssa_.output];
 }
 
@@ -1082,18 +1071,7 @@ double IncrementalPointEvaluator::eval(double x, double y, double z, double t)
     const Instruction& ins = code[i];
     s[ins.out] = applyScalar<double>(ins.op, s[ins.a], s[ins.b], s[ins.c]);
   };
-  if (first_)
-  {
-    first_ = false;
-    for (std::size_t i = 0; i < code.size(); ++i)
-    {
-      run(i);
-    }
-  }
-  else
-  {
-    ssa_.forEachDependent(changed, run);
-  }
+  ssa_.forEachDependent(changed, std::exchange(first_, false), run);
   return s[ssa_.output];
 }
 

@@ -125,12 +125,21 @@ struct SsaCode
   /// The instructions (indices into code) that depend on an axis in `changed` (bit a: Axis(a)),
   /// listed when first asked, so that an eval runs them without testing the others.
   const std::vector<std::uint32_t>& dependents(unsigned changed);
-  /// Calls run(i) for every instruction i that depends on an axis in `changed`, in order: when
-  /// every axis changed, by testing each instruction's axes (a list would only add an
-  /// indirection), else from the list.
+  /// Calls run(i) for every instruction i that depends on an axis in `changed`, in order (`all`:
+  /// for every instruction, those of constants and parameters alone too, as an evaluator's first
+  /// eval needs): when every axis changed, by testing each instruction's axes (a list would only
+  /// add an indirection), else from the list.
   template <typename Run>
-  void forEachDependent(unsigned changed, Run&& run)
+  void forEachDependent(unsigned changed, bool all, Run&& run)
   {
+    if (all)
+    {
+      for (std::size_t i = 0; i < code.size(); ++i)
+      {
+        run(i);
+      }
+      return;
+    }
     if ((changed & used) == used)
     {
       for (std::size_t i = 0; i < code.size(); ++i)
