@@ -130,7 +130,7 @@ struct SsaCode
   /// eval needs): when every axis changed, by testing each instruction's axes (a list would only
   /// add an indirection), else from the list.
   template <typename Run>
-  void forEachDependent(unsigned changed, bool all, Run&& run)
+  [[gnu::always_inline]] void forEachDependent(unsigned changed, bool all, Run&& run)
   {
     if (all)
     {
