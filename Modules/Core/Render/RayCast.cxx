@@ -706,8 +706,8 @@ private:
 
   /// A piece no longer than a leaf. Its ends are sampled before it is bounded: an end inside
   /// settles the piece without an interval, whose bound would only have confirmed it (on
-  /// render-sphere-gyroid, most leaves that are reached hold the surface); only a piece with both
-  /// ends outside needs the interval to tell an empty piece from a feature hiding inside it.
+  /// render-sphere-gyroid about a third of the leaves reached hold the surface); only a piece
+  /// with both ends outside needs the interval to tell an empty piece from a feature inside it.
   bool leaf(Workspace& ws, detail::Stage& stage, Ray& ray, double a, double b)
   {
     const double fa = f(ws, stage, ray, a);
