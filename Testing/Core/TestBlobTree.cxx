@@ -55,6 +55,23 @@ double bruteDistance(const std::function<Vec3(double)>& c, const Vec3& p, int sa
   return best;
 }
 
+// A random box of a test of bounds: for each axis its low corner drawn from `corner`, then its
+// side from `side` (lo and size give them back for sampling inside); t fixed at 0.
+Region randomRegion(std::mt19937& rng, std::uniform_real_distribution<double>& corner,
+  std::uniform_real_distribution<double>& side, std::array<double, 3>& lo,
+  std::array<double, 3>& size)
+{
+  Region region;
+  for (int k = 0; k < 3; ++k)
+  {
+    lo[k] = corner(rng);
+    size[k] = side(rng);
+    region.axes[k] = Interval{ lo[k], lo[k] + size[k] };
+  }
+  region.axes[3] = Interval{ 0, 0 };
+  return region;
+}
+
 } // namespace
 
 TEST(BlobTree, KernelAtKnownDistances)
@@ -197,16 +214,8 @@ TEST(BlobTree, BoundingBoxShortCircuitAndIntervals)
   PointEvaluator point(tape);
   for (int r = 0; r < 200; ++r)
   {
-    Region region;
     std::array<double, 3> lo{}, size{};
-    for (int k = 0; k < 3; ++k)
-    {
-      lo[k] = u(rng);
-      size[k] = w(rng);
-      region.axes[k] = Interval{ lo[k], lo[k] + size[k] };
-    }
-    region.axes[3] = Interval{ 0, 0 };
-    const Interval bound = interval.eval(region);
+    const Interval bound = interval.eval(randomRegion(rng, u, w, lo, size));
     for (int s = 0; s < 100; ++s)
     {
       std::array<double, 3> p{};
@@ -1026,16 +1035,8 @@ TEST(BlobTree, BoxElement)
   std::uniform_real_distribution<double> size(0.05, 1.0);
   for (int r = 0; r < 200; ++r)
   {
-    Region region;
     std::array<double, 3> lo{}, w{};
-    for (int k = 0; k < 3; ++k)
-    {
-      lo[k] = x(rng);
-      w[k] = size(rng);
-      region.axes[k] = Interval{ lo[k], lo[k] + w[k] };
-    }
-    region.axes[3] = Interval{ 0, 0 };
-    const Interval bound = interval.eval(region);
+    const Interval bound = interval.eval(randomRegion(rng, x, size, lo, w));
     for (int s = 0; s < 50; ++s)
     {
       const double f =

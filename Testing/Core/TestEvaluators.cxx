@@ -255,31 +255,24 @@ struct IntervalEvaluatorUnderTest
   std::function<std::function<Interval(const Region&, std::vector<Choice>&)>(TapePtr)> make;
 };
 
+// An interval evaluator of type E made for a tape, as IntervalEvaluatorUnderTest::make.
+template <typename E>
+std::function<Interval(const Region&, std::vector<Choice>&)> underTest(TapePtr tape)
+{
+  auto e = std::make_shared<E>(tape);
+  return [e](const Region& r, std::vector<Choice>& choices)
+  {
+    const Interval v = e->eval(r);
+    choices = e->choices();
+    return v;
+  };
+}
+
 std::vector<IntervalEvaluatorUnderTest> intervalEvaluators()
 {
   return {
-    { "IntervalEvaluator",
-      [](TapePtr tape)
-      {
-        auto e = std::make_shared<IntervalEvaluator>(tape);
-        return [e](const Region& r, std::vector<Choice>& choices)
-        {
-          const Interval v = e->eval(r);
-          choices = e->choices();
-          return v;
-        };
-      } },
-    { "IncrementalIntervalEvaluator",
-      [](TapePtr tape)
-      {
-        auto e = std::make_shared<IncrementalIntervalEvaluator>(tape);
-        return [e](const Region& r, std::vector<Choice>& choices)
-        {
-          const Interval v = e->eval(r);
-          choices = e->choices();
-          return v;
-        };
-      } },
+    { "IntervalEvaluator", underTest<IntervalEvaluator> },
+    { "IncrementalIntervalEvaluator", underTest<IncrementalIntervalEvaluator> },
   };
 }
 
